@@ -1,0 +1,29 @@
+// skinmesh: molecular skin surfaces, quality meshes and morphs.
+#include "commands.hpp"
+
+#include "skinmesh/core/error.hpp"
+
+#include <iostream>
+
+int main(int argc, char** argv) {
+  CLI::App app{"skinmesh: quality meshes of molecular skin surfaces"};
+  app.require_subcommand(1);
+  app.fallthrough();  // --json and --quiet may follow the subcommand
+  skinmesh::app::GlobalOptions global;
+  app.add_flag("--json", global.json, "machine-readable JSON on stdout");
+  app.add_flag("--quiet,-q", global.quiet, "no progress or warnings on the terminal");
+  int exit_code = 0;
+  skinmesh::app::add_info_command(app, global, exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const skinmesh::InputError& e) {
+    std::cerr << "skinmesh: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "skinmesh: error: " << e.what() << "\n";
+    return 1;
+  }
+  return exit_code;
+}

@@ -1,0 +1,136 @@
+// The mixed complex of a ball set and the skin surface on it (MATH.md section 3;
+// H. Edelsbrunner, "Deformable smooth surface design", Discrete Comput. Geom. 21
+// (1999) 87-115). Built once from the regular triangulation (CGAL, exact
+// predicates, used only inside build); afterwards a plain value that answers
+// point location, the skin function, projection and segment crossings, and is
+// safe to query from many threads.
+//
+// Every query takes an optional cell hint and returns the cell it ended in, so
+// that a mesh vertex can remember its mixed cell and be moved and re-projected
+// with a short walk instead of a search.
+#pragma once
+
+#include "skinmesh/core/balls.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
+namespace skinmesh {
+
+// One cell mu_X = (1-s) delta_X + s nu_X of the mixed complex.
+struct MixedCell {
+  int dim = 0;                             // dimension of delta_X: 0 vertex .. 3 tetrahedron
+  std::array<int, 4> balls{{-1, -1, -1, -1}};  // X as indices into SkinComplex::balls(), ascending
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // z_X = aff(delta_X) ∩ aff(nu_X)
+  double R2 = 0.0;                         // squared radius of the sphere orthogonal to X (Angstrom^2)
+  Eigen::Matrix3d P = Eigen::Matrix3d::Zero();  // orthogonal projector onto the directions of aff(delta_X)
+  // Rows 0..dim-1: x -> affine coordinates of x in delta_X relative to its first
+  // vertex (barycentric coordinate i+1); unused rows are zero.
+  Eigen::Matrix3d to_affine = Eigen::Matrix3d::Zero();
+  bool degenerate = false;                 // delta_X affinely dependent (cospherical input)
+};
+
+struct SkinEval {
+  int cell = -1;
+  double value = 0.0;                      // F(x): negative inside the body, zero on the skin
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();  // grad F = 2 (x - Z l*), points outward
+};
+
+struct Projection {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  int cell = -1;
+  int iterations = 0;
+  bool converged = false;
+  double distance = 0.0;                   // |F| / |grad F| at the result (first-order distance, Angstrom)
+};
+
+struct SegmentCrossing {
+  double t = 0.0;                          // parameter on a + t (b - a), in [0, 1]
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  int cell = -1;
+  bool entering = false;                   // F goes from + to - (the segment enters the body)
+};
+
+struct PrincipalCurvatures {
+  double k1 = 0.0, k2 = 0.0;               // k1 >= k2, 1/Angstrom; positive where the body is convex
+  Eigen::Vector3d d1 = Eigen::Vector3d::Zero(), d2 = Eigen::Vector3d::Zero();  // principal directions
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit outward normal
+  double max_abs() const;
+};
+
+struct SkinComplexOptions {
+  double shrink = 0.5;                     // s in (0,1)
+};
+
+class SkinComplex {
+ public:
+  double shrink() const { return shrink_; }
+  const std::vector<Ball>& balls() const { return balls_; }
+  const std::vector<MixedCell>& cells() const { return cells_; }
+  const MixedCell& cell(int index) const { return cells_[static_cast<size_t>(index)]; }
+  int triangulation_dimension() const { return dimension_; }  // of the regular triangulation: 0..3
+  const std::vector<int>& hidden_balls() const { return hidden_; }  // redundant balls, no cell of their own
+  std::array<long, 4> cell_counts() const;                          // by dimension of delta_X
+  long degenerate_cell_count() const;
+  int vertex_cell(int ball) const { return vertex_cell_[static_cast<size_t>(ball)]; }  // -1 if hidden
+
+  // Faces of a cell (X minus one ball; the i-th drops balls[i]) and cofaces (X plus one ball).
+  struct Coface {
+    int ball;
+    int cell;
+  };
+  const int* faces_begin(int c) const { return faces_.data() + face_offset_[c]; }
+  const int* faces_end(int c) const { return faces_.data() + face_offset_[c + 1]; }
+  const Coface* cofaces_begin(int c) const { return cofaces_.data() + coface_offset_[c]; }
+  const Coface* cofaces_end(int c) const { return cofaces_.data() + coface_offset_[c + 1]; }
+
+  // Q_X(x) = (1-s)|(I-P)(x-z)|^2 - s|P(x-z)|^2 + s(1-s)R2, equal to (1-s) F(x) on mu_X.
+  double quadric(int cell, const Eigen::Vector3d& x) const;
+  // Largest violation of x in mu_X (Angstrom-scaled): <= 0 means inside.
+  double membership_violation(int cell, const Eigen::Vector3d& x) const;
+
+  // The mixed cell holding x. hint: a cell near x (e.g. the one a vertex was in).
+  int locate(const Eigen::Vector3d& x, int hint = -1) const;
+  SkinEval evaluate(const Eigen::Vector3d& x, int hint = -1) const;
+  double value(const Eigen::Vector3d& x, int hint = -1) const { return evaluate(x, hint).value; }
+
+  // Newton iteration x <- x - F grad F / |grad F|^2 with cell switching, until
+  // |F|/|grad F| <= tolerance (Angstrom).
+  Projection project(const Eigen::Vector3d& x, int hint = -1, double tolerance = 1e-12) const;
+
+  // Every point where the segment a-b crosses the skin, ordered by t: exact per
+  // mixed cell (the skin is a quadric there), walking the cells along the segment.
+  std::vector<SegmentCrossing> intersect_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                                 int hint = -1) const;
+
+  // Principal curvatures of the skin patch of `cell` at x (x on or near the skin).
+  PrincipalCurvatures curvature(const Eigen::Vector3d& x, int cell) const;
+
+ private:
+  friend SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options);
+  int start_cell(const Eigen::Vector3d& x) const;
+  int locate_by_search(const Eigen::Vector3d& x) const;
+
+  double shrink_ = 0.5;
+  int dimension_ = -1;
+  std::vector<Ball> balls_;
+  std::vector<MixedCell> cells_;
+  std::vector<int> hidden_;
+  std::vector<int> vertex_cell_;
+  std::vector<int> face_offset_, faces_;
+  std::vector<int> coface_offset_;
+  std::vector<Coface> cofaces_;
+  // Uniform grid over the centres of the non-hidden balls: a start for walks.
+  Eigen::Vector3d grid_origin_ = Eigen::Vector3d::Zero();
+  double grid_step_ = 1.0;
+  std::array<int, 3> grid_size_{{1, 1, 1}};
+  std::vector<int> grid_offset_, grid_balls_;
+};
+
+// Throws std::invalid_argument on an empty or non-finite ball set or a shrink
+// factor outside (0,1).
+SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options = {});
+
+}  // namespace skinmesh

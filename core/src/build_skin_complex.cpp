@@ -1,0 +1,204 @@
+// Construction of the mixed complex from CGAL's regular triangulation (exact
+// predicates). CGAL stays in this file: the complex it produces is plain data.
+#include "skinmesh/core/skin_complex.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace skinmesh {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb0 = CGAL::Regular_triangulation_vertex_base_3<K>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, Vb0>;
+using Cb = CGAL::Regular_triangulation_cell_base_3<K>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
+using Regular = CGAL::Regular_triangulation_3<K, Tds>;
+
+using Key = std::array<int, 4>;  // ascending ball indices, padded with -1
+struct KeyHash {
+  size_t operator()(const Key& k) const {
+    size_t h = 1469598103934665603ull;
+    for (int v : k) h = (h ^ static_cast<size_t>(v + 1)) * 1099511628211ull;
+    return h;
+  }
+};
+
+Key make_key(std::array<int, 4> ids, int count) {
+  std::sort(ids.begin(), ids.begin() + count);
+  for (int i = count; i < 4; ++i) ids[i] = -1;
+  return ids;
+}
+
+// Centre z_X (equal power to every ball of X within aff(delta_X)), size R2 and
+// the projector onto the directions of aff(delta_X) (MATH.md section 3).
+void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
+  const Ball& b0 = balls[cell.balls[0]];
+  const int d = cell.dim;
+  if (d == 0) {
+    cell.center = b0.center;
+    cell.R2 = -b0.weight;
+    return;
+  }
+  Eigen::Matrix<double, 3, Eigen::Dynamic> E(3, d);
+  Eigen::VectorXd rhs(d);
+  for (int j = 0; j < d; ++j) {
+    const Ball& bj = balls[cell.balls[j + 1]];
+    E.col(j) = bj.center - b0.center;
+    // |z - z_j|^2 - w_j = |z - z_0|^2 - w_0  <=>  2 <z - z_0, e_j> = |e_j|^2 - w_j + w_0
+    rhs[j] = E.col(j).squaredNorm() - bj.weight + b0.weight;
+  }
+  const Eigen::MatrixXd gram = E.transpose() * E;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
+  const double largest = eig.eigenvalues().maxCoeff();
+  const double smallest = eig.eigenvalues().minCoeff();
+  Eigen::MatrixXd gram_inv;
+  if (smallest > 1e-14 * largest) {
+    gram_inv = gram.inverse();
+  } else {
+    // Affinely dependent vertices (a flat simplex from cospherical input):
+    // pseudo-inverse on the span that exists.
+    cell.degenerate = true;
+    Eigen::VectorXd inv = eig.eigenvalues();
+    for (int i = 0; i < d; ++i) inv[i] = inv[i] > 1e-14 * largest ? 1.0 / inv[i] : 0.0;
+    gram_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  }
+  const Eigen::VectorXd a = 0.5 * gram_inv * rhs;
+  const Eigen::Vector3d offset = E * a;
+  cell.center = b0.center + offset;
+  cell.R2 = offset.squaredNorm() - b0.weight;
+  cell.P = E * gram_inv * E.transpose();
+  const Eigen::MatrixXd affine = gram_inv * E.transpose();
+  for (int j = 0; j < d; ++j) cell.to_affine.row(j) = affine.row(j);
+}
+
+}  // namespace
+
+SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options) {
+  if (!(options.shrink > 0.0 && options.shrink < 1.0))
+    throw std::invalid_argument("shrink factor must lie in (0,1), got " + std::to_string(options.shrink));
+  if (balls.empty()) throw std::invalid_argument("cannot build a skin complex of no balls");
+  for (const Ball& b : balls)
+    if (!b.center.allFinite() || !std::isfinite(b.weight))
+      throw std::invalid_argument("ball with a non-finite centre or weight");
+
+  SkinComplex sc;
+  sc.shrink_ = options.shrink;
+  sc.balls_ = std::move(balls);
+  const int n = static_cast<int>(sc.balls_.size());
+
+  std::vector<std::pair<Regular::Weighted_point, int>> points;
+  points.reserve(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const Ball& b = sc.balls_[static_cast<size_t>(i)];
+    points.emplace_back(Regular::Weighted_point(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight), i);
+  }
+  Regular rt(points.begin(), points.end());
+  sc.dimension_ = rt.dimension();
+
+  // Simplices of every dimension, as sorted ball tuples.
+  std::vector<MixedCell>& cells = sc.cells_;
+  auto add = [&](std::array<int, 4> ids, int count) {
+    MixedCell c;
+    c.dim = count - 1;
+    c.balls = make_key(ids, count);
+    cells.push_back(c);
+  };
+  sc.vertex_cell_.assign(static_cast<size_t>(n), -1);
+  for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) {
+    sc.vertex_cell_[static_cast<size_t>(v->info())] = static_cast<int>(cells.size());
+    add({v->info(), -1, -1, -1}, 1);
+  }
+  for (int i = 0; i < n; ++i)
+    if (sc.vertex_cell_[static_cast<size_t>(i)] < 0) sc.hidden_.push_back(i);
+  if (rt.dimension() >= 1)
+    for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e)
+      add({e->first->vertex(e->second)->info(), e->first->vertex(e->third)->info(), -1, -1}, 2);
+  if (rt.dimension() >= 2)
+    for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
+      std::array<int, 4> ids{};
+      for (int k = 0; k < 3; ++k) ids[k] = f->first->vertex((f->second + 1 + k) & 3)->info();
+      add(ids, 3);
+    }
+  if (rt.dimension() == 3)
+    for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c)
+      add({c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()}, 4);
+
+  std::unordered_map<Key, int, KeyHash> index;
+  index.reserve(cells.size() * 2);
+  for (size_t i = 0; i < cells.size(); ++i) index.emplace(cells[i].balls, static_cast<int>(i));
+
+  // Faces (drop one ball) and cofaces (add one ball), in CSR form.
+  const size_t m = cells.size();
+  sc.face_offset_.assign(m + 1, 0);
+  std::vector<int> coface_count(m, 0);
+  for (size_t i = 0; i < m; ++i) sc.face_offset_[i + 1] = sc.face_offset_[i] + (cells[i].dim > 0 ? cells[i].dim + 1 : 0);
+  sc.faces_.assign(static_cast<size_t>(sc.face_offset_[m]), -1);
+  for (size_t i = 0; i < m; ++i) {
+    const MixedCell& c = cells[i];
+    if (c.dim == 0) continue;
+    for (int drop = 0; drop <= c.dim; ++drop) {
+      std::array<int, 4> ids{{-1, -1, -1, -1}};
+      int k = 0;
+      for (int j = 0; j <= c.dim; ++j)
+        if (j != drop) ids[k++] = c.balls[j];
+      const int face = index.at(make_key(ids, k));
+      sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)] = face;
+      ++coface_count[static_cast<size_t>(face)];
+    }
+  }
+  sc.coface_offset_.assign(m + 1, 0);
+  for (size_t i = 0; i < m; ++i) sc.coface_offset_[i + 1] = sc.coface_offset_[i] + coface_count[i];
+  sc.cofaces_.resize(static_cast<size_t>(sc.coface_offset_[m]));
+  std::vector<int> fill(sc.coface_offset_.begin(), sc.coface_offset_.end() - 1);
+  for (size_t i = 0; i < m; ++i) {
+    const MixedCell& c = cells[i];
+    for (int drop = 0; drop < (c.dim > 0 ? c.dim + 1 : 0); ++drop) {
+      const int face = sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)];
+      sc.cofaces_[static_cast<size_t>(fill[static_cast<size_t>(face)]++)] = {c.balls[drop], static_cast<int>(i)};
+    }
+  }
+
+  for (MixedCell& c : cells) compute_cell_geometry(c, sc.balls_);
+
+  // Start-point grid over the centres of the non-hidden balls.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = -lo;
+  std::vector<int> live;
+  for (int i = 0; i < n; ++i)
+    if (sc.vertex_cell_[static_cast<size_t>(i)] >= 0) {
+      live.push_back(i);
+      lo = lo.cwiseMin(sc.balls_[static_cast<size_t>(i)].center);
+      hi = hi.cwiseMax(sc.balls_[static_cast<size_t>(i)].center);
+    }
+  const Eigen::Vector3d extent = (hi - lo).cwiseMax(1e-9);
+  const double volume = extent.prod();
+  sc.grid_step_ = std::max({2.0, std::cbrt(volume / static_cast<double>(live.size()) * 2.0), extent.maxCoeff() / 256.0});
+  sc.grid_origin_ = lo;
+  for (int k = 0; k < 3; ++k) sc.grid_size_[k] = std::max(1, static_cast<int>(std::floor(extent[k] / sc.grid_step_)) + 1);
+  const size_t buckets = static_cast<size_t>(sc.grid_size_[0]) * sc.grid_size_[1] * sc.grid_size_[2];
+  sc.grid_offset_.assign(buckets + 1, 0);
+  auto bucket_of = [&](const Eigen::Vector3d& p) {
+    std::array<int, 3> b{};
+    for (int k = 0; k < 3; ++k)
+      b[k] = std::clamp(static_cast<int>((p[k] - sc.grid_origin_[k]) / sc.grid_step_), 0, sc.grid_size_[k] - 1);
+    return (static_cast<size_t>(b[2]) * sc.grid_size_[1] + b[1]) * sc.grid_size_[0] + b[0];
+  };
+  for (int i : live) ++sc.grid_offset_[bucket_of(sc.balls_[static_cast<size_t>(i)].center) + 1];
+  for (size_t b = 0; b < buckets; ++b) sc.grid_offset_[b + 1] += sc.grid_offset_[b];
+  sc.grid_balls_.resize(live.size());
+  std::vector<int> cursor(sc.grid_offset_.begin(), sc.grid_offset_.end() - 1);
+  for (int i : live) sc.grid_balls_[static_cast<size_t>(cursor[bucket_of(sc.balls_[static_cast<size_t>(i)].center)]++)] = i;
+  return sc;
+}
+
+}  // namespace skinmesh

@@ -1,0 +1,23 @@
+#include "skinmesh/core/error.hpp"
+
+namespace skinmesh {
+
+namespace {
+std::string format_input_error(const std::string& file, long line, const std::string& message) {
+  std::string where = file.empty() ? std::string("<input>") : file;
+  if (line > 0) where += ":" + std::to_string(line);
+  return where + ": " + message;
+}
+}  // namespace
+
+InputError::InputError(std::string file, long line, const std::string& message)
+    : std::runtime_error(format_input_error(file, line, message)),
+      file_(std::move(file)),
+      line_(line),
+      message_(message) {}
+
+void input_error(const std::string& file, long line, const std::string& message) {
+  throw InputError(file, line, message);
+}
+
+}  // namespace skinmesh

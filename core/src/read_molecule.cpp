@@ -1,0 +1,224 @@
+// Format dispatch and the filters every format shares.
+#include "reader_detail.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/radii.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <tuple>
+#include <unordered_map>
+
+namespace skinmesh {
+
+// Coordinates beyond this make 1e-9 A accuracy on the skin meaningless in
+// double precision (and are never real structures).
+constexpr double kMaxCoordinate = 1.0e5;  // Angstrom
+
+const char* format_name(MoleculeFormat format) {
+  switch (format) {
+    case MoleculeFormat::Pdb: return "PDB";
+    case MoleculeFormat::Mmcif: return "mmCIF";
+    case MoleculeFormat::Pqr: return "PQR";
+    case MoleculeFormat::Xyzr: return "XYZR";
+  }
+  return "?";
+}
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string where(const std::string& path, const Atom& atom) {
+  std::ostringstream out;
+  out << path;
+  if (atom.line > 0) out << ":" << atom.line;
+  out << " (atom " << atom.name << " " << atom.residue << " " << atom.chain << atom.residue_number << ")";
+  return out.str();
+}
+
+std::vector<detail::RawModel> read_raw_models(const std::string& path, MoleculeFormat format,
+                                              std::vector<std::string>& warnings) {
+  std::string text = detail::read_file_text(path);
+  switch (format) {
+    case MoleculeFormat::Pdb:
+    case MoleculeFormat::Mmcif: return detail::read_pdb_or_mmcif(path, std::move(text), format, warnings);
+    case MoleculeFormat::Pqr: return detail::read_pqr(path, text);
+    case MoleculeFormat::Xyzr: return detail::read_xyzr(path, text);
+  }
+  return {};
+}
+
+// One conformer per atom: among the alternate locations of one atom (same chain,
+// residue number, insertion code and name) keep the highest occupancy; ties go
+// to the first in the file.
+std::vector<detail::RawAtom> pick_conformers(std::vector<detail::RawAtom> atoms, long& dropped) {
+  using Key = std::tuple<std::string, int, char, std::string>;
+  std::map<Key, size_t> best;
+  for (size_t i = 0; i < atoms.size(); ++i) {
+    const Atom& a = atoms[i].atom;
+    if (a.altloc == ' ') continue;
+    const Key key{a.chain, a.residue_number, a.insertion_code, a.name};
+    auto [it, inserted] = best.emplace(key, i);
+    if (!inserted && a.occupancy > atoms[it->second].atom.occupancy) it->second = i;
+  }
+  std::vector<detail::RawAtom> kept;
+  kept.reserve(atoms.size());
+  for (size_t i = 0; i < atoms.size(); ++i) {
+    const Atom& a = atoms[i].atom;
+    if (a.altloc != ' ' && best.at(Key{a.chain, a.residue_number, a.insertion_code, a.name}) != i) {
+      ++dropped;
+      continue;
+    }
+    kept.push_back(std::move(atoms[i]));
+  }
+  return kept;
+}
+
+Molecule filter_model(const std::string& path, MoleculeFormat format, detail::RawModel raw, int model_number,
+                      int models_in_file, const ReadOptions& options, const std::vector<std::string>& warnings) {
+  Molecule m;
+  m.source = path;
+  m.format = format;
+  m.model = model_number;
+  m.models_in_file = models_in_file;
+  m.warnings = warnings;
+
+  std::vector<detail::RawAtom> atoms;
+  atoms.reserve(raw.size());
+  for (detail::RawAtom& r : raw) {
+    if (!options.chains.empty() &&
+        std::find(options.chains.begin(), options.chains.end(), r.atom.chain) == options.chains.end()) {
+      ++m.skipped["chain not selected"];
+      continue;
+    }
+    if (r.water && !options.keep_waters) {
+      ++m.skipped["water"];
+      continue;
+    }
+    if (r.hydrogen && !options.keep_hydrogens) {
+      ++m.skipped["hydrogen"];
+      continue;
+    }
+    atoms.push_back(std::move(r));
+  }
+  long altloc_dropped = 0;
+  atoms = pick_conformers(std::move(atoms), altloc_dropped);
+  if (altloc_dropped) m.skipped["alternate location"] += altloc_dropped;
+
+  for (detail::RawAtom& r : atoms) {
+    Atom& a = r.atom;
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(a.position[k])) input_error(path, a.line, "non-finite coordinate in " + where(path, a));
+      if (std::abs(a.position[k]) > kMaxCoordinate) {
+        std::ostringstream msg;
+        msg << "coordinate " << a.position[k] << " is beyond +-" << kMaxCoordinate
+            << " Angstrom: not a molecular structure";
+        input_error(path, a.line, msg.str());
+      }
+    }
+    if (!r.radius_given) {
+      if (auto radius = bondi_radius(a.element)) {
+        a.radius = *radius;
+      } else {
+        if (options.strict_elements)
+          input_error(path, a.line, "unknown element '" + a.element + "' (no Bondi radius) for " + where(path, a));
+        a.radius = options.unknown_radius;
+        ++m.unknown_elements[a.element.empty() ? "?" : a.element];
+      }
+    } else if (a.radius == 0.0) {
+      ++m.skipped["zero radius"];
+      continue;
+    }
+    m.atoms.push_back(std::move(a));
+  }
+  for (const auto& [element, count] : m.unknown_elements) {
+    std::ostringstream msg;
+    msg << path << ": " << count << " atom(s) of element '" << element << "' have no Bondi radius; used "
+        << options.unknown_radius << " A";
+    m.warnings.push_back(msg.str());
+  }
+
+  if (m.atoms.empty()) {
+    std::ostringstream msg;
+    msg << "no atoms left after filtering";
+    if (!m.skipped.empty()) {
+      msg << " (dropped:";
+      for (const auto& [reason, count] : m.skipped) msg << " " << count << " " << reason;
+      msg << "; see --keep-hydrogens, --keep-waters, --chain)";
+    }
+    input_error(path, 0, msg.str());
+  }
+
+  // Atoms at one position: geometrically the smaller ball is hidden (a
+  // duplicate is hidden by its twin), so this is a warning, not an error.
+  struct Hash {
+    size_t operator()(const Eigen::Vector3d& p) const {
+      std::hash<double> h;
+      return h(p[0]) ^ (h(p[1]) * 31) ^ (h(p[2]) * 131);
+    }
+  };
+  struct Equal {
+    bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return a == b; }
+  };
+  std::unordered_map<Eigen::Vector3d, size_t, Hash, Equal> seen;
+  long coincident = 0;
+  std::string first_pair;
+  for (size_t i = 0; i < m.atoms.size(); ++i) {
+    auto [it, inserted] = seen.emplace(m.atoms[i].position, i);
+    if (!inserted) {
+      if (coincident++ == 0)
+        first_pair = where(path, m.atoms[it->second]) + " and " + where(path, m.atoms[i]);
+    }
+  }
+  if (coincident)
+    m.warnings.push_back(path + ": " + std::to_string(coincident) +
+                         " atom(s) share a position with another atom, first " + first_pair +
+                         "; the smaller ball of each group is hidden");
+  return m;
+}
+
+}  // namespace
+
+MoleculeFormat format_from_path(const std::string& path) {
+  std::string name = lower(path);
+  if (ends_with(name, ".gz")) name.resize(name.size() - 3);
+  if (ends_with(name, ".cif") || ends_with(name, ".mmcif")) return MoleculeFormat::Mmcif;
+  if (ends_with(name, ".pqr")) return MoleculeFormat::Pqr;
+  if (ends_with(name, ".xyzr") || ends_with(name, ".xyzrn")) return MoleculeFormat::Xyzr;
+  return MoleculeFormat::Pdb;  // .pdb, .ent and anything else: PDB, which gemmi reads leniently
+}
+
+Molecule read_molecule(const std::string& path, const ReadOptions& options) {
+  const MoleculeFormat format = format_from_path(path);
+  std::vector<std::string> warnings;
+  std::vector<detail::RawModel> models = read_raw_models(path, format, warnings);
+  const int count = static_cast<int>(models.size());
+  if (options.model < 1 || options.model > count)
+    input_error(path, 0,
+                "model " + std::to_string(options.model) + " requested, but the file has " + std::to_string(count) +
+                    " model(s)");
+  return filter_model(path, format, std::move(models[options.model - 1]), options.model, count, options, warnings);
+}
+
+std::vector<Molecule> read_all_models(const std::string& path, const ReadOptions& options) {
+  const MoleculeFormat format = format_from_path(path);
+  std::vector<std::string> warnings;
+  std::vector<detail::RawModel> models = read_raw_models(path, format, warnings);
+  std::vector<Molecule> out;
+  const int count = static_cast<int>(models.size());
+  for (int i = 0; i < count; ++i)
+    out.push_back(filter_model(path, format, std::move(models[i]), i + 1, count, options, warnings));
+  return out;
+}
+
+}  // namespace skinmesh

@@ -1,0 +1,304 @@
+// Queries on the mixed complex: location by walking, the skin function (the
+// per-cell quadric of MATH.md section 3), projection, segment crossings and
+// curvature.
+#include "skinmesh/core/skin_complex.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace skinmesh {
+namespace {
+
+constexpr double kBaryTolerance = 1e-12;   // dimensionless
+constexpr double kPlaneTolerance = 1e-11;  // Angstrom
+constexpr int kMaxWalkSteps = 400;
+
+// What is wrong with "x in mu_c": the worst violated constraint and the cell
+// across it. amount <= 0: x is in the cell.
+struct Violation {
+  double amount = -std::numeric_limits<double>::infinity();
+  int target = -1;
+};
+
+}  // namespace
+
+double PrincipalCurvatures::max_abs() const { return std::max(std::abs(k1), std::abs(k2)); }
+
+std::array<long, 4> SkinComplex::cell_counts() const {
+  std::array<long, 4> counts{{0, 0, 0, 0}};
+  for (const MixedCell& c : cells_) ++counts[static_cast<size_t>(c.dim)];
+  return counts;
+}
+
+long SkinComplex::degenerate_cell_count() const {
+  return std::count_if(cells_.begin(), cells_.end(), [](const MixedCell& c) { return c.degenerate; });
+}
+
+double SkinComplex::quadric(int c, const Eigen::Vector3d& x) const {
+  const MixedCell& cell = cells_[static_cast<size_t>(c)];
+  const double s = shrink_;
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d py = cell.P * y;
+  return (1 - s) * (y - py).squaredNorm() - s * py.squaredNorm() + s * (1 - s) * cell.R2;
+}
+
+// x = (1-s) d + s v with d = z + P(x-z)/(1-s) in aff(delta_X) and v = z + (I-P)(x-z)/s
+// in aff(nu_X); x is in mu_X iff d is in delta_X (barycentric coordinates >= 0)
+// and v is in nu_X (no ball of a coface has smaller power at v).
+static Violation worst_violation(const SkinComplex& sc, int c, const Eigen::Vector3d& x) {
+  const MixedCell& cell = sc.cell(c);
+  const double s = sc.shrink();
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d py = cell.P * y;
+  Violation worst;
+  const Ball& b0 = sc.balls()[static_cast<size_t>(cell.balls[0])];
+  if (cell.dim > 0) {
+    const Eigen::Vector3d d = cell.center + py / (1 - s);
+    const Eigen::Vector3d affine = cell.to_affine * (d - b0.center);
+    double bary0 = 1.0;
+    for (int j = 0; j < cell.dim; ++j) bary0 -= affine[j];
+    const int* faces = sc.faces_begin(c);
+    for (int j = 0; j <= cell.dim; ++j) {
+      const double bary = j == 0 ? bary0 : affine[j - 1];
+      if (-bary > kBaryTolerance && -bary > worst.amount) worst = {-bary, faces[j]};
+    }
+    if (worst.target >= 0) return worst;
+  }
+  const Eigen::Vector3d v = cell.center + (y - py) / s;
+  const double pi0 = b0.power(v);
+  for (auto it = sc.cofaces_begin(c); it != sc.cofaces_end(c); ++it) {
+    const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
+    const double gap = (bk.center - b0.center).norm();
+    const double slack = (bk.power(v) - pi0) / (2 * std::max(gap, 1e-300));  // signed distance to the bisector
+    if (-slack > kPlaneTolerance && -slack > worst.amount) worst = {-slack, it->cell};
+  }
+  return worst;
+}
+
+double SkinComplex::membership_violation(int c, const Eigen::Vector3d& x) const {
+  const Violation v = worst_violation(*this, c, x);
+  return v.target < 0 ? 0.0 : v.amount;
+}
+
+int SkinComplex::start_cell(const Eigen::Vector3d& x) const {
+  std::array<int, 3> b{};
+  for (int k = 0; k < 3; ++k)
+    b[k] = std::clamp(static_cast<int>(std::floor((x[k] - grid_origin_[k]) / grid_step_)), 0, grid_size_[k] - 1);
+  int best = -1;
+  double best_power = std::numeric_limits<double>::infinity();
+  const int max_ring = std::max({grid_size_[0], grid_size_[1], grid_size_[2]});
+  for (int ring = 0, found_ring = -1; ring <= max_ring; ++ring) {
+    if (found_ring >= 0 && ring > found_ring + 1) break;
+    for (int i = b[0] - ring; i <= b[0] + ring; ++i)
+      for (int j = b[1] - ring; j <= b[1] + ring; ++j)
+        for (int k = b[2] - ring; k <= b[2] + ring; ++k) {
+          if (std::max({std::abs(i - b[0]), std::abs(j - b[1]), std::abs(k - b[2])}) != ring) continue;
+          if (i < 0 || j < 0 || k < 0 || i >= grid_size_[0] || j >= grid_size_[1] || k >= grid_size_[2]) continue;
+          const size_t bucket = (static_cast<size_t>(k) * grid_size_[1] + j) * grid_size_[0] + i;
+          for (int p = grid_offset_[bucket]; p < grid_offset_[bucket + 1]; ++p) {
+            const int ball = grid_balls_[static_cast<size_t>(p)];
+            const double power = balls_[static_cast<size_t>(ball)].power(x);
+            if (power < best_power) {
+              best_power = power;
+              best = ball;
+            }
+          }
+        }
+    if (best >= 0 && found_ring < 0) found_ring = ring;
+  }
+  return vertex_cell_[static_cast<size_t>(best)];
+}
+
+int SkinComplex::locate_by_search(const Eigen::Vector3d& x) const {
+  int best = 0;
+  double best_amount = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < static_cast<int>(cells_.size()); ++c) {
+    const Violation v = worst_violation(*this, c, x);
+    const double amount = v.target < 0 ? 0.0 : v.amount;
+    if (amount < best_amount) {
+      best_amount = amount;
+      best = c;
+      if (amount <= 0) break;
+    }
+  }
+  return best;
+}
+
+int SkinComplex::locate(const Eigen::Vector3d& x, int hint) const {
+  int c = (hint >= 0 && hint < static_cast<int>(cells_.size())) ? hint : start_cell(x);
+  for (int step = 0; step < kMaxWalkSteps; ++step) {
+    const Violation v = worst_violation(*this, c, x);
+    if (v.target < 0) return c;
+    c = v.target;
+  }
+  return locate_by_search(x);  // the walk cycled (never seen on real input; kept as a safety net)
+}
+
+SkinEval SkinComplex::evaluate(const Eigen::Vector3d& x, int hint) const {
+  SkinEval e;
+  e.cell = locate(x, hint);
+  const MixedCell& cell = cells_[static_cast<size_t>(e.cell)];
+  const double s = shrink_;
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d py = cell.P * y;
+  e.value = (y - py).squaredNorm() - s / (1 - s) * py.squaredNorm() + s * cell.R2;  // Q_X / (1-s)
+  e.gradient = 2.0 * (y - py) - (2.0 * s / (1 - s)) * py;
+  return e;
+}
+
+Projection SkinComplex::project(const Eigen::Vector3d& x0, int hint, double tolerance) const {
+  constexpr int kMaxIterations = 60;
+  constexpr double kMaxStep = 2.0;  // Angstrom: a Newton step longer than this is damped
+  Projection out;
+  out.point = x0;
+  out.cell = hint;
+  for (int it = 0; it < kMaxIterations; ++it) {
+    const SkinEval e = evaluate(out.point, out.cell);
+    out.cell = e.cell;
+    const double g2 = e.gradient.squaredNorm();
+    out.iterations = it;
+    if (g2 < 1e-24) return out;  // at a centre of the body: no direction to go
+    out.distance = std::abs(e.value) / std::sqrt(g2);
+    if (out.distance <= tolerance) {
+      out.converged = true;
+      return out;
+    }
+    Eigen::Vector3d step = -(e.value / g2) * e.gradient;
+    const double length = step.norm();
+    if (length > kMaxStep) step *= kMaxStep / length;
+    out.point += step;
+  }
+  const SkinEval e = evaluate(out.point, out.cell);
+  out.cell = e.cell;
+  out.iterations = kMaxIterations;
+  out.distance = std::abs(e.value) / std::max(e.gradient.norm(), 1e-300);
+  out.converged = out.distance <= tolerance;
+  return out;
+}
+
+std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                                            int hint) const {
+  std::vector<SegmentCrossing> out;
+  const Eigen::Vector3d dir = b - a;
+  const double s = shrink_;
+  if (dir.squaredNorm() == 0.0) return out;
+  int c = locate(a, hint);
+  double t = 0.0;
+  int stalled = 0;
+  const int max_cells = 20000;
+  for (int visit = 0; visit < max_cells; ++visit) {
+    const MixedCell& cell = cells_[static_cast<size_t>(c)];
+    const Ball& b0 = balls_[static_cast<size_t>(cell.balls[0])];
+    const Eigen::Vector3d y0 = a - cell.center;
+
+    // Where the segment leaves mu_c: every constraint is affine in t.
+    double t_exit = std::numeric_limits<double>::infinity();
+    int next = -1;
+    auto consider = [&](double value0, double slope, int target) {
+      if (slope >= 0) return;
+      const double crossing = std::max(t, -value0 / slope);
+      if (crossing < t_exit) {
+        t_exit = crossing;
+        next = target;
+      }
+    };
+    if (cell.dim > 0) {
+      const Eigen::Vector3d d0 = cell.center + cell.P * y0 / (1 - s) - b0.center;
+      const Eigen::Vector3d d1 = cell.P * dir / (1 - s);
+      const Eigen::Vector3d A0 = cell.to_affine * d0, A1 = cell.to_affine * d1;
+      double bary0 = 1.0, slope0 = 0.0;
+      for (int j = 0; j < cell.dim; ++j) {
+        bary0 -= A0[j];
+        slope0 -= A1[j];
+      }
+      const int* faces = faces_begin(c);
+      consider(bary0, slope0, faces[0]);
+      for (int j = 1; j <= cell.dim; ++j) consider(A0[j - 1], A1[j - 1], faces[j]);
+    }
+    const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
+    const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;
+    for (auto it = cofaces_begin(c); it != cofaces_end(c); ++it) {
+      const Ball& bk = balls_[static_cast<size_t>(it->ball)];
+      // pi_k(v) - pi_0(v) = -2 <v, z_k - z_0> + |z_k|^2 - w_k - |z_0|^2 + w_0
+      const Eigen::Vector3d dz = bk.center - b0.center;
+      consider(bk.power(v0) - b0.power(v0), -2.0 * v1.dot(dz), it->cell);
+    }
+
+    // Roots of Q_c(a + t dir) = A t^2 + B t + C on [t, min(t_exit, 1)].
+    const double hi = std::min(t_exit, 1.0);
+    const Eigen::Vector3d pd = cell.P * dir, py = cell.P * y0;
+    const double A = (1 - s) * (dir - pd).squaredNorm() - s * pd.squaredNorm();
+    const double B = 2.0 * ((1 - s) * (y0 - py).dot(dir - pd) - s * py.dot(pd));
+    const double C = (1 - s) * (y0 - py).squaredNorm() - s * py.squaredNorm() + s * (1 - s) * cell.R2;
+    double roots[2];
+    int count = 0;
+    const double scale = std::abs(A) + std::abs(B) + std::abs(C);
+    if (std::abs(A) <= 1e-15 * scale) {
+      if (B != 0.0) roots[count++] = -C / B;
+    } else {
+      const double disc = B * B - 4 * A * C;
+      if (disc >= 0) {
+        const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+        roots[count++] = q / A;
+        if (q != 0.0) roots[count++] = C / q;
+        if (count == 2 && roots[0] > roots[1]) std::swap(roots[0], roots[1]);
+      }
+    }
+    const double eps = 1e-13;
+    for (int r = 0; r < count; ++r) {
+      const double u = roots[r];
+      if (u < t - eps || u > hi + eps || u < -eps || u > 1 + eps) continue;
+      const double uc = std::clamp(u, 0.0, 1.0);
+      if (!out.empty() && std::abs(out.back().t - uc) < 1e-10) continue;
+      out.push_back({uc, a + uc * dir, c, 2 * A * u + B < 0});
+    }
+    if (t_exit >= 1.0 || next < 0) break;
+
+    // Zero-length steps go round a face where several cells meet; after a few,
+    // step over it by locating slightly further along.
+    if (t_exit <= t) {
+      if (++stalled > 8) {
+        t = std::min(1.0, t + 1e-12);
+        c = locate(a + t * dir, c);
+        stalled = 0;
+        continue;
+      }
+    } else {
+      stalled = 0;
+    }
+    t = t_exit;
+    c = next;
+  }
+  return out;
+}
+
+PrincipalCurvatures SkinComplex::curvature(const Eigen::Vector3d& x, int c) const {
+  const MixedCell& cell = cells_[static_cast<size_t>(c)];
+  const double s = shrink_;
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  // F = Q/(1-s): gradient 2(I-P)y - 2s/(1-s) P y, constant Hessian 2(I-P) - 2s/(1-s) P.
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d g = 2.0 * (y - cell.P * y) - (2.0 * s / (1 - s)) * (cell.P * y);
+  const Eigen::Matrix3d H = 2.0 * (I - cell.P) - (2.0 * s / (1 - s)) * cell.P;
+  PrincipalCurvatures pc;
+  const double gn = g.norm();
+  if (gn == 0.0) return pc;
+  pc.normal = g / gn;
+  // Tangent frame, then the shape operator T^T H T / |g| of the level set.
+  Eigen::Vector3d t1 = pc.normal.unitOrthogonal();
+  Eigen::Vector3d t2 = pc.normal.cross(t1);
+  Eigen::Matrix<double, 3, 2> T;
+  T << t1, t2;
+  const Eigen::Matrix2d S = T.transpose() * H * T / gn;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(S);
+  pc.k1 = eig.eigenvalues()[1];
+  pc.k2 = eig.eigenvalues()[0];
+  pc.d1 = T * eig.eigenvectors().col(1);
+  pc.d2 = T * eig.eigenvectors().col(0);
+  return pc;
+}
+
+}  // namespace skinmesh

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Install skinmesh's dependencies from Debian 12 packages and build it in Release.
+# Run as root (or with sudo) from anywhere inside the repository:
+#     bash scripts/setup.sh            # install + configure + build
+#     SKINMESH_SKIP_INSTALL=1 bash scripts/setup.sh   # build only
+set -euo pipefail
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+packages=(
+  build-essential cmake pkg-config ccache
+  libcgal-dev libgmp-dev libmpfr-dev libboost-dev   # regular triangulation, exact predicates, Skin_surface_3
+  libeigen3-dev                                     # small dense linear algebra
+  libopenmesh-dev                                   # surface mesh and local edits
+  tetgen                                            # volume meshes, self-intersection check
+  catch2                                            # tests (v2)
+  gemmi-dev tao-pegtl-dev zlib1g-dev                # PDB/mmCIF input (gemmi's cif.hpp needs PEGTL)
+  libtbb-dev                                        # threads
+  libcli11-dev                                      # command line
+  nlohmann-json3-dev                                # JSON reports
+)
+
+if [ "${SKINMESH_SKIP_INSTALL:-0}" != 1 ]; then
+  missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    sudo_cmd=""
+    [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+    $sudo_cmd apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  fi
+fi
+
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}"
+cmake --build "$here/build" -j "$(nproc)"
