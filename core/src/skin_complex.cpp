@@ -149,18 +149,40 @@ SkinEval SkinComplex::evaluate(const Eigen::Vector3d& x, int hint) const {
   return e;
 }
 
-Projection SkinComplex::project(const Eigen::Vector3d& x0, int hint, double tolerance) const {
+Projection SkinComplex::project_onto(const Eigen::Vector3d& x0, int hint, double tolerance) const {
   constexpr int kMaxIterations = 60;
-  constexpr double kMaxStep = 2.0;  // Angstrom: a Newton step longer than this is damped
+  constexpr double kMaxStep = 2.0;    // Angstrom: a Newton step longer than this is damped
+  constexpr double kMaxReach = 6.0;   // Angstrom: how far along the gradient line to look
   Projection out;
   out.point = x0;
   out.cell = hint;
+  const SkinEval start = evaluate(x0, hint);
+  out.cell = start.cell;
+  const double g0 = start.gradient.norm();
+  if (g0 > 1e-12) {
+    out.distance = std::abs(start.value) / g0;
+    if (out.distance <= tolerance) {
+      out.converged = true;
+      return out;
+    }
+    // The skin is a quadric in each cell, so the crossing of the gradient line
+    // is exact; Newton's iteration on a saddle-shaped patch can wander instead.
+    const Eigen::Vector3d toward = (start.value > 0 ? -1.0 : 1.0) * start.gradient / g0;
+    const double reach = std::min(kMaxReach, std::max(0.5, 4.0 * out.distance));
+    const auto hits = intersect_segment(x0, x0 + reach * toward, start.cell);
+    if (!hits.empty()) {
+      out.point = hits.front().point;
+      out.cell = hits.front().cell;
+    }
+  }
+  // Newton polish (one step on an exact crossing), or the whole way when the
+  // gradient line missed the skin: damped so that |F| decreases every step.
+  SkinEval e = evaluate(out.point, out.cell);
   for (int it = 0; it < kMaxIterations; ++it) {
-    const SkinEval e = evaluate(out.point, out.cell);
     out.cell = e.cell;
     const double g2 = e.gradient.squaredNorm();
-    out.iterations = it;
-    if (g2 < 1e-24) return out;  // at a centre of the body: no direction to go
+    out.iterations = it + 1;
+    if (g2 < 1e-24) return out;  // at a critical point of F: no direction to go
     out.distance = std::abs(e.value) / std::sqrt(g2);
     if (out.distance <= tolerance) {
       out.converged = true;
@@ -169,14 +191,37 @@ Projection SkinComplex::project(const Eigen::Vector3d& x0, int hint, double tole
     Eigen::Vector3d step = -(e.value / g2) * e.gradient;
     const double length = step.norm();
     if (length > kMaxStep) step *= kMaxStep / length;
+    SkinEval trial;
+    for (int halving = 0; halving < 30; ++halving, step *= 0.5) {
+      trial = evaluate(out.point + step, e.cell);
+      if (std::abs(trial.value) < std::abs(e.value)) break;
+    }
     out.point += step;
+    e = trial;
   }
-  const SkinEval e = evaluate(out.point, out.cell);
-  out.cell = e.cell;
-  out.iterations = kMaxIterations;
-  out.distance = std::abs(e.value) / std::max(e.gradient.norm(), 1e-300);
-  out.converged = out.distance <= tolerance;
   return out;
+}
+
+Projection SkinComplex::project(const Eigen::Vector3d& x0, int hint, double tolerance) const {
+  // First onto the skin, then towards the closest point: move tangentially
+  // towards x0 and back onto the skin until x0 - p is parallel to the normal at p
+  // (the first-order condition of the closest point).
+  Projection p = project_onto(x0, hint, tolerance);
+  if (!p.converged) return p;
+  int total = p.iterations;
+  for (int it = 0; it < 30; ++it) {
+    const SkinEval e = evaluate(p.point, p.cell);
+    const Eigen::Vector3d n = e.gradient.normalized();
+    const Eigen::Vector3d offset = x0 - p.point;
+    const Eigen::Vector3d tangential = offset - offset.dot(n) * n;
+    if (tangential.norm() <= 1e-10 * (1.0 + offset.norm())) break;
+    Projection next = project_onto(p.point + tangential, p.cell, tolerance);
+    total += next.iterations;
+    if (!next.converged || (next.point - x0).norm() >= (p.point - x0).norm()) break;
+    p = next;
+  }
+  p.iterations = total;
+  return p;
 }
 
 std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,

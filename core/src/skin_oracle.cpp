@@ -55,6 +55,9 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
   }
   std::vector<int> S{start};
   std::vector<double> l{1.0};
+  // After a full step the weights sit at the minimiser on S: the next solve's
+  // step is round-off, so go straight to the multipliers.
+  bool at_subproblem_minimum = true;
   for (int iteration = 0; iteration < 200; ++iteration) {
     const int k = static_cast<int>(S.size());
     Eigen::Vector3d y = Eigen::Vector3d::Zero();
@@ -94,7 +97,8 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
       step = d * 1e30;  // unbounded along d: the ratio test below stops it
     }
     const double step_norm = step.cwiseAbs().maxCoeff();
-    if (!singular && step_norm <= 1e-15) {
+    if (!singular && (at_subproblem_minimum || step_norm <= 1e-15)) {
+      at_subproblem_minimum = false;
       // Stationary on S: check the multipliers of the inactive bounds.
       int entering = -1;
       double most_negative = -1e-13 * (1.0 + std::abs(mu));
@@ -117,6 +121,7 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
         if (limit < alpha) alpha = limit, blocking = a;
       }
     for (int a = 0; a < k; ++a) l[a] += alpha * step[a];
+    at_subproblem_minimum = blocking < 0;
     if (blocking >= 0) {
       S.erase(S.begin() + blocking);
       l.erase(l.begin() + blocking);

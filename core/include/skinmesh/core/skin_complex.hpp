@@ -96,8 +96,9 @@ class SkinComplex {
   SkinEval evaluate(const Eigen::Vector3d& x, int hint = -1) const;
   double value(const Eigen::Vector3d& x, int hint = -1) const { return evaluate(x, hint).value; }
 
-  // Newton iteration x <- x - F grad F / |grad F|^2 with cell switching, until
-  // |F|/|grad F| <= tolerance (Angstrom).
+  // The closest skin point to x (locally): onto the skin along the gradient line
+  // (exact per cell, Newton iteration with cell switching as the fallback), then
+  // tangential corrections, until |F|/|grad F| <= tolerance (Angstrom).
   Projection project(const Eigen::Vector3d& x, int hint = -1, double tolerance = 1e-12) const;
 
   // Every point where the segment a-b crosses the skin, ordered by t: exact per
@@ -111,6 +112,7 @@ class SkinComplex {
  private:
   friend SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options);
   int start_cell(const Eigen::Vector3d& x) const;
+  Projection project_onto(const Eigen::Vector3d& x, int hint, double tolerance) const;
   int locate_by_search(const Eigen::Vector3d& x) const;
 
   double shrink_ = 0.5;
