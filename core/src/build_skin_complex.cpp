@@ -49,35 +49,38 @@ void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
     cell.R2 = -b0.weight;
     return;
   }
-  Eigen::Matrix<double, 3, Eigen::Dynamic> E(3, d);
-  Eigen::VectorXd rhs(d);
+  // Fixed capacity (at most 3 directions): no heap allocation per cell.
+  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+  Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3> E(3, d);
+  Vec rhs(d);
   for (int j = 0; j < d; ++j) {
     const Ball& bj = balls[cell.balls[j + 1]];
     E.col(j) = bj.center - b0.center;
     // |z - z_j|^2 - w_j = |z - z_0|^2 - w_0  <=>  2 <z - z_0, e_j> = |e_j|^2 - w_j + w_0
     rhs[j] = E.col(j).squaredNorm() - bj.weight + b0.weight;
   }
-  const Eigen::MatrixXd gram = E.transpose() * E;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
+  const Mat gram = E.transpose() * E;
+  Eigen::SelfAdjointEigenSolver<Mat> eig(gram);
   const double largest = eig.eigenvalues().maxCoeff();
   const double smallest = eig.eigenvalues().minCoeff();
-  Eigen::MatrixXd gram_inv;
+  Mat gram_inv;
   if (smallest > 1e-14 * largest) {
     gram_inv = gram.inverse();
   } else {
     // Affinely dependent vertices (a flat simplex from cospherical input):
     // pseudo-inverse on the span that exists.
     cell.degenerate = true;
-    Eigen::VectorXd inv = eig.eigenvalues();
+    Vec inv = eig.eigenvalues();
     for (int i = 0; i < d; ++i) inv[i] = inv[i] > 1e-14 * largest ? 1.0 / inv[i] : 0.0;
     gram_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
   }
-  const Eigen::VectorXd a = 0.5 * gram_inv * rhs;
+  const Vec a = 0.5 * gram_inv * rhs;
   const Eigen::Vector3d offset = E * a;
   cell.center = b0.center + offset;
   cell.R2 = offset.squaredNorm() - b0.weight;
   cell.P = E * gram_inv * E.transpose();
-  const Eigen::MatrixXd affine = gram_inv * E.transpose();
+  const Mat affine = gram_inv * E.transpose();
   for (int j = 0; j < d; ++j) cell.to_affine.row(j) = affine.row(j);
 }
 
