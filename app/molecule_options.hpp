@@ -21,8 +21,8 @@ struct MoleculeOptions {
   }
 };
 
-inline void add_molecule_options(CLI::App& cmd, MoleculeOptions& o) {
-  cmd.add_option("molecule", o.path, "PDB, mmCIF (.cif), PQR or XYZR file, optionally .gz")->required();
+// Filters, radii and skin parameters (without the file itself).
+inline void add_molecule_settings(CLI::App& cmd, MoleculeOptions& o) {
   cmd.add_option("--model", o.read.model, "1-based model to read from a multi-model file")->check(CLI::PositiveNumber);
   cmd.add_flag("--all-models", o.all_models, "take every model (a list of conformations)");
   cmd.add_option("--chain", o.read.chains, "keep only these chains (repeatable)");
@@ -34,6 +34,12 @@ inline void add_molecule_options(CLI::App& cmd, MoleculeOptions& o) {
   cmd.add_option("--shrink,-s", o.shrink, "shrink factor s in (0,1)")->check(CLI::Range(1e-6, 1.0 - 1e-6));
   cmd.add_option("--weights", o.weights, "ball weights: grow (w = r^2/s, skin near the vdW surface) or raw (w = r^2)")
       ->check(CLI::IsMember({"grow", "raw"}));
+}
+
+// The molecule as the subcommand's positional argument, plus its settings.
+inline void add_molecule_options(CLI::App& cmd, MoleculeOptions& o) {
+  cmd.add_option("molecule", o.path, "PDB, mmCIF (.cif), PQR or XYZR file, optionally .gz")->required();
+  add_molecule_settings(cmd, o);
 }
 
 }  // namespace skinmesh::app

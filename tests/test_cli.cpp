@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 
 #include <array>
+#include <cmath>
+#include <fstream>
 #include <cstdio>
 #include <sys/wait.h>
 
@@ -66,4 +68,35 @@ TEST_CASE("skinmesh info runs on every shared PDB entry", "[cli]") {
     CHECK(r.code == 0);
     CHECK(r.output.find("mixed cells:") != std::string::npos);
   }
+}
+
+TEST_CASE("skinmesh quality grades a mesh file, writes an SVG, measures on-surface error", "[cli][quality]") {
+  // A regular tetrahedron with circumradius 1.7 about the origin, and one atom of
+  // radius 1.7 there: with w = r^2/s the atom's skin is that circumsphere.
+  const double h = 1.7 / std::sqrt(3.0);
+  char off[512];
+  std::snprintf(off, sizeof off,
+                "OFF\n4 4 0\n%.17g %.17g %.17g\n%.17g %.17g %.17g\n%.17g %.17g %.17g\n%.17g %.17g %.17g\n"
+                "3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n",
+                h, h, h, h, -h, -h, -h, h, -h, -h, -h, h);
+  skinmesh::test::TempFile mesh("tet.off", off);
+  skinmesh::test::TempFile atom("atom.xyzr", "0 0 0 1.7\n");
+  const std::string svg = mesh.path() + ".svg";
+  const Run r = run("quality " + mesh.path() + " --molecule " + atom.path() + " --svg " + svg + " --json");
+  INFO(r.output);
+  CHECK(r.code == 0);
+  CHECK(r.output.find("\"euler_characteristic\": 2") != std::string::npos);
+  CHECK(r.output.find("\"self_intersecting_pairs\": 0") != std::string::npos);
+  const size_t at = r.output.find("\"max\":", r.output.find("\"on_surface_error\""));
+  REQUIRE(at != std::string::npos);
+  CHECK(std::stod(r.output.substr(at + 6)) < 1e-12);
+  std::ifstream in(svg);
+  std::string first;
+  std::getline(in, first);
+  CHECK(first.rfind("<svg", 0) == 0);
+  std::remove(svg.c_str());
+
+  const Run missing = run("quality /nonexistent/mesh.off");
+  CHECK(missing.code == 2);
+  CHECK(missing.output.find("/nonexistent/mesh.off") != std::string::npos);
 }

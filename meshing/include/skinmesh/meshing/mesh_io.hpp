@@ -1,0 +1,18 @@
+// Reading surface meshes from other tools as polygon soups (so that a broken
+// mesh can be graded, not rejected): OFF, OBJ, STL (ASCII and binary), PLY
+// (ASCII and binary little/big endian), and MSMS .vert/.face pairs.
+#pragma once
+
+#include "skinmesh/core/surface_mesh.hpp"
+
+#include <string>
+
+namespace skinmesh {
+
+// Chooses the format from the extension (.off .obj .stl .ply .vert .face; for
+// MSMS either file of the pair). Polygons with more than three corners are fanned
+// into triangles. STL corners are merged when their coordinates are identical.
+// Throws InputError naming the file and line.
+SurfaceMesh read_surface_mesh(const std::string& path);
+
+}  // namespace skinmesh
