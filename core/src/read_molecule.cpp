@@ -2,6 +2,7 @@
 #include "reader_detail.hpp"
 
 #include "skinmesh/core/error.hpp"
+#include "skinmesh/core/file_names.hpp"
 #include "skinmesh/core/radii.hpp"
 
 #include <algorithm>
@@ -28,15 +29,6 @@ const char* format_name(MoleculeFormat format) {
 }
 
 namespace {
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 std::string where(const std::string& path, const Atom& atom) {
   std::ostringstream out;
@@ -190,11 +182,11 @@ Molecule filter_model(const std::string& path, MoleculeFormat format, detail::Ra
 }  // namespace
 
 MoleculeFormat format_from_path(const std::string& path) {
-  std::string name = lower(path);
-  if (ends_with(name, ".gz")) name.resize(name.size() - 3);
-  if (ends_with(name, ".cif") || ends_with(name, ".mmcif")) return MoleculeFormat::Mmcif;
-  if (ends_with(name, ".pqr")) return MoleculeFormat::Pqr;
-  if (ends_with(name, ".xyzr") || ends_with(name, ".xyzrn")) return MoleculeFormat::Xyzr;
+  std::string name = lowercase(path);
+  if (has_extension(name, ".gz")) name.resize(name.size() - 3);
+  if (has_extension(name, ".cif") || has_extension(name, ".mmcif")) return MoleculeFormat::Mmcif;
+  if (has_extension(name, ".pqr")) return MoleculeFormat::Pqr;
+  if (has_extension(name, ".xyzr") || has_extension(name, ".xyzrn")) return MoleculeFormat::Xyzr;
   return MoleculeFormat::Pdb;  // .pdb, .ent and anything else: PDB, which gemmi reads leniently
 }
 

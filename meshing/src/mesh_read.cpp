@@ -1,6 +1,7 @@
 #include "skinmesh/meshing/mesh_io.hpp"
 
 #include "skinmesh/core/error.hpp"
+#include "skinmesh/core/file_names.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,15 +13,6 @@
 
 namespace skinmesh {
 namespace {
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 std::string read_all(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -342,13 +334,12 @@ SurfaceMesh read_msms(const std::string& path) {
 }  // namespace
 
 SurfaceMesh read_surface_mesh(const std::string& path) {
-  const std::string name = lower(path);
   SurfaceMesh mesh;
-  if (ends_with(name, ".off")) mesh = read_off(path);
-  else if (ends_with(name, ".obj")) mesh = read_obj(path);
-  else if (ends_with(name, ".stl")) mesh = read_stl(path);
-  else if (ends_with(name, ".ply")) mesh = read_ply(path);
-  else if (ends_with(name, ".vert") || ends_with(name, ".face")) mesh = read_msms(path);
+  if (has_extension(path, ".off")) mesh = read_off(path);
+  else if (has_extension(path, ".obj")) mesh = read_obj(path);
+  else if (has_extension(path, ".stl")) mesh = read_stl(path);
+  else if (has_extension(path, ".ply")) mesh = read_ply(path);
+  else if (has_extension(path, ".vert") || has_extension(path, ".face")) mesh = read_msms(path);
   else input_error(path, 0, "unknown mesh format (expected .off, .obj, .stl, .ply, or an MSMS .vert/.face pair)");
   if (mesh.triangles.empty()) input_error(path, 0, "mesh has no triangles");
   return mesh;
