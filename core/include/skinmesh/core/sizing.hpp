@@ -9,7 +9,7 @@
 namespace skinmesh {
 
 struct SizingOptions {
-  double epsilon = 0.4;   // target edge length / local radius of curvature (dimensionless)
+  double epsilon = 0.8;   // target edge length / local radius of curvature (dimensionless)
   double min_size = 0.05; // Angstrom: floor where curvature explodes (a pinching neck)
   double max_size = 3.0;  // Angstrom
 };

@@ -1,0 +1,81 @@
+// The quality skin mesher: restricted Delaunay refinement on the exact skin
+// (in the style of H.-L. Cheng and X. Shi, "Quality mesh generation for molecular
+// skin surfaces using restricted union of balls", and J.-D. Boissonnat and S.
+// Oudot, "Provably good sampling and meshing of surfaces", Graph. Models 2005).
+//
+// Samples lie exactly on the skin. Their 3D Delaunay triangulation (CGAL, kept
+// inside the implementation) restricted to the skin is the mesh: a triangle for
+// every Delaunay facet whose dual Voronoi edge crosses the skin, and the
+// crossing is the centre of the triangle's "surface Delaunay ball". Refinement
+// inserts that centre while a triangle is too big for the local curvature, too
+// far from the skin, has a smallest angle under the bound, or the topology
+// conditions fail (a Voronoi edge crossing the skin twice, a vertex whose
+// triangles are not one disk). Every component of the skin is seeded by the
+// points where its normal takes four fixed directions, which every closed
+// component has.
+#pragma once
+
+#include "skinmesh/core/sizing.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+namespace skinmesh {
+
+struct MeshingProgress {
+  const char* stage = "";      // "seeding", "refining", "checking", "cleaning"
+  long vertices = 0;
+  long pending = 0;            // bad triangles waiting in the queue
+};
+
+struct MeshingOptions {
+  double min_angle = 30.0;     // degrees: every triangle's smallest angle at least this (at most 30)
+  // Sizing: a uniform target edge length in Angstrom when > 0, else the
+  // curvature-relative sizing (edge ~ epsilon / max |curvature|, clamped).
+  double edge_length = 0.0;
+  SizingOptions sizing;
+  // Largest distance (Angstrom) between a triangle's circumcentre and the skin
+  // along the triangle's normal line (its Voronoi edge).
+  double tolerance = 0.1;
+  long max_triangles = 4'000'000;  // refinement stops with MeshingError past this
+  // Edge contraction after refinement: remove a vertex with an edge shorter than
+  // contract_below * target edge length when the triangles it leaves still meet
+  // every criterion. 0 turns it off.
+  double contract_below = 0.4;
+  int threads = 0;             // 0: all hardware threads
+  std::function<void(const MeshingProgress&)> progress;  // called now and then, from the calling thread
+};
+
+struct MeshingStats {
+  long seeds = 0;
+  long inserted_size = 0, inserted_shape = 0, inserted_distance = 0;
+  long inserted_topology = 0;      // Voronoi edges crossing twice, non-disk vertex stars, isolated samples
+  long contracted = 0;             // vertices removed by edge contraction
+  long contraction_rejected = 0;   // contractions undone because a criterion failed
+  int passes = 0;                  // global verification passes over all Delaunay facets
+  double seconds_seeding = 0, seconds_refining = 0, seconds_contracting = 0, seconds_total = 0;
+};
+
+struct SkinMeshResult {
+  SurfaceMesh mesh;                // triangles oriented outward; normals and mixed cells per vertex
+  MeshingStats stats;
+};
+
+// Refinement ran past the triangle budget, or a sample could not be repaired.
+class MeshingError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Throws std::invalid_argument for options out of range and MeshingError when
+// refinement cannot finish within the budget.
+SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& options = {});
+
+// The target edge length at a skin point x of `cell` under `options`.
+double target_edge_length(const SkinComplex& complex, const Eigen::Vector3d& x, int cell,
+                          const MeshingOptions& options);
+
+}  // namespace skinmesh

@@ -1,0 +1,543 @@
+// Restricted Delaunay refinement of the skin (see skin_mesher.hpp). This is the
+// only translation unit that sees the 3D Delaunay triangulation.
+#include "skinmesh/meshing/skin_mesher.hpp"
+
+#include "skin_seeds.hpp"
+
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_cell_base_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <Eigen/Geometry>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <queue>
+#include <tuple>
+#include <unordered_map>
+
+namespace skinmesh {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+struct VertexInfo {
+  int cell = -1;  // mixed cell of the sample (a hint for every walk that starts near it)
+  int id = -1;    // insertion order
+};
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<VertexInfo, K>;
+// Cell info: a stamp that changes whenever the cell is (re)created, so that an
+// evaluation of a facet can tell whether its Voronoi edge is still the same.
+using Cb = CGAL::Triangulation_cell_base_with_info_3<unsigned, K, CGAL::Delaunay_triangulation_cell_base_3<K>>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
+using Delaunay = CGAL::Delaunay_triangulation_3<K, Tds>;
+using Vertex_handle = Delaunay::Vertex_handle;
+using Cell_handle = Delaunay::Cell_handle;
+using Facet = Delaunay::Facet;
+using Clock = std::chrono::steady_clock;
+
+Eigen::Vector3d to_eigen(const K::Point_3& p) { return {p.x(), p.y(), p.z()}; }
+
+enum class Defect { none, topology, size, distance, shape };
+
+// What the Voronoi edge dual to one Delaunay facet says about it.
+struct FacetEval {
+  int crossings = 0;                 // of the Voronoi edge with the skin; restricted iff > 0
+  Eigen::Vector3d center;            // surface Delaunay ball centre (farthest crossing if several)
+  int cell = -1;                     // its mixed cell
+  double radius = 0;                 // surface Delaunay ball radius
+  Eigen::Vector3d outward;           // outward skin normal direction along the Voronoi edge
+  Defect defect = Defect::none;
+  bool force = false;                // a vertex-star repair: insert even without a defect
+  std::array<Vertex_handle, 3> v;
+  unsigned stamp_c = 0, stamp_n = 0; // of the two cells when evaluated
+};
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+class Refiner {
+ public:
+  Refiner(const SkinComplex& complex, const MeshingOptions& options) : complex_(complex), options_(options) {
+    // The skin lies inside the union of the input balls: rays beyond this box miss it.
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    double max_radius = 0;
+    for (const Ball& b : complex.balls()) {
+      lo = lo.cwiseMin(b.center);
+      hi = hi.cwiseMax(b.center);
+      max_radius = std::max(max_radius, std::sqrt(std::max(0.0, b.weight)));
+    }
+    box_center_ = 0.5 * (lo + hi);
+    box_radius_ = 0.5 * (hi - lo).norm() + max_radius + 1.0;
+    const double angle = options.min_angle * M_PI / 180.0;
+    max_radius_edge_ = 1.0 / (2.0 * std::sin(angle));
+  }
+
+  SkinMeshResult run();
+
+ private:
+  FacetEval evaluate(const Facet& facet) const;
+  void insert_seeds();
+  Vertex_handle insert(const Eigen::Vector3d& p, int cell, Cell_handle hint);
+  void push_if_bad(FacetEval e, bool force = false);
+  void refine();
+  std::vector<Facet> star_facets(Vertex_handle v) const;  // after insert(v)
+  std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
+  bool global_pass(std::vector<FacetEval>* restricted);
+  void contract();
+  SurfaceMesh extract(const std::vector<FacetEval>& restricted) const;
+  void report(const char* stage, bool always = false);
+  void check_budget() const;
+
+  const SkinComplex& complex_;
+  const MeshingOptions& options_;
+  Delaunay dt_;
+  std::vector<FacetEval> pending_;   // bad facets waiting for their surface ball centre
+  std::vector<Cell_handle> star_;    // cells made by the last insertion
+  unsigned stamp_ = 0;
+  Eigen::Vector3d box_center_;
+  double box_radius_ = 0;
+  double max_radius_edge_ = 1;
+  int next_id_ = 0;
+  MeshingStats stats_;
+  Clock::time_point last_report_ = Clock::now();
+};
+
+FacetEval Refiner::evaluate(const Facet& facet) const {
+  Cell_handle c = facet.first;
+  int i = facet.second;
+  if (dt_.is_infinite(c)) {
+    Cell_handle m = c->neighbor(i);
+    i = m->index(c);
+    c = m;
+  }
+  FacetEval e;
+  e.stamp_c = c->info();
+  e.stamp_n = c->neighbor(i)->info();
+  for (int k = 0; k < 3; ++k) e.v[static_cast<size_t>(k)] = c->vertex((i + 1 + k) & 3);
+  const Eigen::Vector3d p0 = to_eigen(e.v[0]->point()), p1 = to_eigen(e.v[1]->point()),
+                        p2 = to_eigen(e.v[2]->point());
+  // The Voronoi edge lies on the line through the triangle's circumcentre along
+  // its normal. Computing it from the triangle, and only the parameters of its
+  // ends from the two tetrahedra, keeps it accurate when a tetrahedron is flat
+  // (nearly cocircular samples, common on sphere patches) and its circumcentre
+  // is ill-conditioned: every point found on it is then truly equidistant from
+  // the triangle's vertices.
+  const Eigen::Vector3d u = p1 - p0, w = p2 - p0;
+  const Eigen::Vector3d uxw = u.cross(w);
+  const double cross2 = uxw.squaredNorm();
+  if (!(cross2 > 0)) return e;  // collinear samples: no triangle, nothing to test
+  const Eigen::Vector3d circumcenter = p0 + (u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)) / (2.0 * cross2);
+  const Eigen::Vector3d normal = uxw / std::sqrt(cross2);
+  const double circumradius2 = (circumcenter - p0).squaredNorm();
+  const double reach = (circumcenter - box_center_).norm() + box_radius_;
+  // Parameter along `normal` of the circumcentre of the tetrahedron with apex q.
+  auto end_parameter = [&](const Eigen::Vector3d& q) {
+    const double height = normal.dot(q - circumcenter);
+    const double numerator = (q - circumcenter).squaredNorm() - circumradius2;
+    if (std::abs(numerator) >= 2.0 * reach * std::abs(height)) return std::copysign(reach, numerator * height);
+    return numerator / (2.0 * height);
+  };
+  const Eigen::Vector3d apex_c = to_eigen(c->vertex(i)->point());
+  const double lambda_a = end_parameter(apex_c);
+  const Cell_handle n = c->neighbor(i);
+  double lambda_b;
+  std::optional<Eigen::Vector3d> apex_n;
+  if (dt_.is_infinite(n)) {
+    // Convex hull facet: the Voronoi edge is a ray leaving the hull.
+    lambda_b = normal.dot(apex_c - circumcenter) > 0 ? -reach : reach;
+  } else {
+    apex_n = to_eigen(n->vertex(n->index(c))->point());
+    lambda_b = end_parameter(*apex_n);
+  }
+  const Eigen::Vector3d a = circumcenter + lambda_a * normal, b = circumcenter + lambda_b * normal;
+  auto hits = complex_.intersect_segment(a, b, e.v[0]->info().cell);
+  // A point inside the Voronoi edge is strictly nearer to the triangle's
+  // vertices than to either apex. When a tetrahedron is flat (its apex
+  // cocircular with the triangle, which refinement on sphere patches does
+  // produce) the end of the edge is ill-conditioned, and where the apex is
+  // equidistant the crossing is a degenerate Voronoi vertex. Such crossings are
+  // dropped: inserting them would land on or next to a sample.
+  hits.erase(std::remove_if(hits.begin(), hits.end(),
+                            [&](const SegmentCrossing& h) {
+                              const double r2 = (h.point - p0).squaredNorm() * (1 + 1e-7);
+                              return (h.point - apex_c).squaredNorm() < r2 ||
+                                     (apex_n && (h.point - *apex_n).squaredNorm() < r2);
+                            }),
+             hits.end());
+  e.crossings = static_cast<int>(hits.size());
+  if (hits.empty()) return e;
+  size_t best = 0;
+  double best_r2 = -1;
+  for (size_t k = 0; k < hits.size(); ++k) {
+    const double r2 = (hits[k].point - p0).squaredNorm();
+    if (r2 > best_r2) {
+      best_r2 = r2;
+      best = k;
+    }
+  }
+  e.center = hits[best].point;
+  e.cell = hits[best].cell;
+  e.radius = std::sqrt(best_r2);
+  e.outward = hits[best].entering ? (a - b) : (b - a);
+  if (hits.size() > 1) {
+    e.defect = Defect::topology;
+    return e;
+  }
+  // Triangle shape: circumradius over shortest edge.
+  const double circumradius = std::sqrt(circumradius2);
+  const double shortest = std::sqrt(std::min({u.squaredNorm(), w.squaredNorm(), (p2 - p1).squaredNorm()}));
+  const double target = target_edge_length(complex_, e.center, e.cell, options_);
+  if (e.radius > target / std::sqrt(3.0))
+    e.defect = Defect::size;
+  else if ((e.center - circumcenter).norm() > options_.tolerance)
+    e.defect = Defect::distance;
+  else if (!(circumradius <= max_radius_edge_ * shortest))
+    e.defect = Defect::shape;
+  return e;
+}
+
+void Refiner::report(const char* stage, bool always) {
+  if (!options_.progress) return;
+  if (!always && seconds_since(last_report_) < 0.25) return;
+  last_report_ = Clock::now();
+  MeshingProgress p;
+  p.stage = stage;
+  p.vertices = static_cast<long>(dt_.number_of_vertices());
+  p.pending = static_cast<long>(pending_.size());
+  options_.progress(p);
+}
+
+void Refiner::check_budget() const {
+  // A closed surface mesh has about twice as many triangles as vertices.
+  const long estimate = 2 * static_cast<long>(dt_.number_of_vertices());
+  if (estimate > options_.max_triangles)
+    throw MeshingError("refinement passed the budget of " + std::to_string(options_.max_triangles) +
+                       " triangles; raise --max-triangles or ask for larger triangles (--epsilon, "
+                       "--edge-length, --tolerance)");
+}
+
+Vertex_handle Refiner::insert(const Eigen::Vector3d& p, int cell, Cell_handle hint) {
+  const Vertex_handle v = dt_.insert(K::Point_3(p[0], p[1], p[2]), hint);
+  if (v->info().id < 0) {
+    v->info().cell = cell;
+    v->info().id = next_id_++;
+    star_.clear();
+    dt_.incident_cells(v, std::back_inserter(star_));
+    for (const Cell_handle& c : star_) c->info() = ++stamp_;
+  }
+  return v;
+}
+
+void Refiner::insert_seeds() {
+  // Seeds closer than a quarter of the target edge length to a kept one are
+  // dropped: a pair of nearly coincident critical points (common where a
+  // critical point sits near a cell boundary) would otherwise force refinement
+  // down to their distance. A component still keeps its seeds unless all of
+  // them lie that close to another component, which the curvature sizing rules
+  // out (a component that small has curvature radius, hence target length, of
+  // its own size or less).
+  const auto seeds = detail::critical_point_seeds(complex_);
+  Cell_handle hint;
+  for (const auto& s : seeds) {
+    const K::Point_3 p(s.point[0], s.point[1], s.point[2]);
+    if (dt_.number_of_vertices() > 0) {
+      const Vertex_handle nearest = dt_.nearest_vertex(p, hint);
+      const Eigen::Vector3d q = to_eigen(nearest->point());
+      const double spacing = 0.25 * std::min(target_edge_length(complex_, s.point, s.cell, options_),
+                                             target_edge_length(complex_, q, nearest->info().cell, options_));
+      if ((q - s.point).norm() < spacing) continue;
+    }
+    const Vertex_handle v = insert(s.point, s.cell, hint);
+    hint = v->cell();
+    ++stats_.seeds;
+  }
+}
+
+void Refiner::push_if_bad(FacetEval e, bool force) {
+  if (e.crossings == 0) return;
+  if (e.defect == Defect::none && !force) return;
+  e.force = force;
+  pending_.push_back(e);
+}
+
+// Every facet of the star of a new vertex is new or has a new Voronoi edge;
+// each is listed once (the cells of the star are the ones the insertion made).
+std::vector<Facet> Refiner::star_facets(Vertex_handle v) const {
+  std::vector<Facet> out;
+  for (const Cell_handle& c : star_) {
+    const bool infinite = dt_.is_infinite(c);
+    const int iv = c->index(v);
+    for (int j = 0; j < 4; ++j) {
+      if (infinite && j != c->index(dt_.infinite_vertex())) continue;  // only its finite facet
+      if (j != iv && &*c->neighbor(j) < &*c) continue;  // a facet through v lies in two cells of the star
+      out.emplace_back(c, j);
+    }
+  }
+  return out;
+}
+
+std::vector<FacetEval> Refiner::evaluate_all(const std::vector<Facet>& facets) const {
+  std::vector<FacetEval> evals(facets.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, facets.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) evals[k] = evaluate(facets[k]);
+  });
+  return evals;
+}
+
+// Refinement: insert the surface ball centre of the pending bad facet with the
+// largest ball, evaluate the facets of the new vertex's star, repeat. An entry
+// whose cells changed since its evaluation is evaluated again first.
+void Refiner::refine() {
+  auto smaller = [](const FacetEval& a, const FacetEval& b) { return a.radius < b.radius; };
+  std::priority_queue<FacetEval, std::vector<FacetEval>, decltype(smaller)> queue(smaller, std::move(pending_));
+  pending_.clear();
+  while (!queue.empty()) {
+    FacetEval e = queue.top();
+    queue.pop();
+    Cell_handle c;
+    int i0, i1, i2;
+    if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) continue;
+    const Cell_handle n = c->neighbor(6 - i0 - i1 - i2);
+    if (!((c->info() == e.stamp_c && n->info() == e.stamp_n) || (c->info() == e.stamp_n && n->info() == e.stamp_c))) {
+      const bool force = e.force;
+      e = evaluate(Facet(c, 6 - i0 - i1 - i2));  // its Voronoi edge changed: look again
+      if (e.crossings > 0 && (e.defect != Defect::none || force)) {
+        e.force = force;
+        queue.push(e);
+      }
+      continue;
+    }
+    if (e.radius < 1e-9) continue;  // cannot happen for a proper triangle; never insert a duplicate
+    // The surface Delaunay ball is empty in exact arithmetic. Near a Voronoi
+    // vertex on the skin two Voronoi edges cross it at almost the same point;
+    // after one is inserted the other must not be (a near-duplicate vertex
+    // would send refinement chasing it).
+    const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
+    if ((to_eigen(nearest->point()) - e.center).norm() < 0.5 * e.radius) continue;
+    switch (e.defect) {
+      case Defect::topology: ++stats_.inserted_topology; break;
+      case Defect::size: ++stats_.inserted_size; break;
+      case Defect::distance: ++stats_.inserted_distance; break;
+      case Defect::shape: ++stats_.inserted_shape; break;
+      case Defect::none: ++stats_.inserted_topology; break;  // forced: a vertex star repair
+    }
+    const int before = next_id_;
+    const Vertex_handle v = insert(e.center, e.cell, c);
+    if (next_id_ == before) continue;  // the point is a sample already
+    for (const Facet& f : star_facets(v)) {
+      const FacetEval te = evaluate(f);
+      if (te.crossings > 0 && te.defect != Defect::none) queue.push(te);
+    }
+    if ((next_id_ & 1023) == 0) {
+      check_budget();
+      pending_.resize(queue.size());  // only its size is reported
+      report("refining");
+      pending_.clear();
+    }
+  }
+}
+
+// Classifies every Delaunay facet (in parallel), queues the bad ones and the
+// repairs of vertex stars that are not disks. Returns true when nothing is left
+// to do; then `restricted` holds the restricted facets.
+bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
+  ++stats_.passes;
+  std::vector<Facet> facets;
+  facets.reserve(dt_.number_of_finite_facets());
+  for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) facets.push_back(*f);
+  const std::vector<FacetEval> evals = evaluate_all(facets);
+  restricted->clear();
+  bool clean = true;
+  for (const FacetEval& e : evals) {
+    if (e.crossings == 0) continue;
+    restricted->push_back(e);
+    if (e.defect != Defect::none) {
+      push_if_bad(e);
+      clean = false;
+    }
+  }
+  if (!clean) return false;
+
+  // Every vertex's restricted triangles must form one disk: its link is a single
+  // cycle (which also makes every edge shared by exactly two triangles).
+  const int n = next_id_;
+  std::vector<std::vector<std::pair<int, int>>> link(static_cast<size_t>(n));
+  std::vector<int> best_facet(static_cast<size_t>(n), -1);
+  for (int f = 0; f < static_cast<int>(restricted->size()); ++f) {
+    const FacetEval& e = (*restricted)[static_cast<size_t>(f)];
+    for (int k = 0; k < 3; ++k) {
+      const int me = e.v[static_cast<size_t>(k)]->info().id;
+      link[static_cast<size_t>(me)].push_back(
+          {e.v[static_cast<size_t>((k + 1) % 3)]->info().id, e.v[static_cast<size_t>((k + 2) % 3)]->info().id});
+      int& best = best_facet[static_cast<size_t>(me)];
+      if (best < 0 || e.radius > (*restricted)[static_cast<size_t>(best)].radius) best = f;
+    }
+  }
+  std::vector<Vertex_handle> isolated;
+  for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end(); ++v) {
+    const int id = v->info().id;
+    auto& edges = link[static_cast<size_t>(id)];
+    if (edges.empty()) {
+      isolated.push_back(v);
+      continue;
+    }
+    // One cycle: every link vertex has degree two and a walk visits every edge.
+    std::unordered_map<int, std::array<int, 2>> adjacent;
+    bool ok = true;
+    for (const auto& [a, b] : edges) {
+      for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}}) {
+        auto [it, fresh] = adjacent.try_emplace(x, std::array<int, 2>{{y, -1}});
+        if (!fresh) {
+          if (it->second[1] >= 0) ok = false;
+          it->second[1] = y;
+        }
+      }
+    }
+    for (const auto& [x, ys] : adjacent)
+      if (ys[1] < 0) ok = false;
+    if (ok) {
+      int prev = edges[0].first, cur = edges[0].second;
+      size_t steps = 1;
+      while (cur != edges[0].first && steps <= edges.size()) {
+        const auto& ys = adjacent[cur];
+        const int next = ys[0] == prev ? ys[1] : ys[0];
+        prev = cur;
+        cur = next;
+        ++steps;
+      }
+      ok = steps == edges.size();
+    }
+    if (!ok) {
+      push_if_bad((*restricted)[static_cast<size_t>(best_facet[static_cast<size_t>(id)])], true);
+      clean = false;
+    }
+  }
+  // A sample with no restricted triangle: the skin around it escapes every
+  // Voronoi edge of its cell. Add the skin point nearest to the farthest
+  // Voronoi vertex of the cell; the triangulation then sees that piece.
+  for (const Vertex_handle& v : isolated) {
+    std::vector<Cell_handle> cells;
+    dt_.incident_cells(v, std::back_inserter(cells));
+    const Eigen::Vector3d pv = to_eigen(v->point());
+    std::optional<Projection> best;
+    for (const Cell_handle& c : cells) {
+      if (dt_.is_infinite(c)) continue;
+      const Projection p = complex_.project(to_eigen(dt_.dual(c)), v->info().cell);
+      if (!p.converged || (p.point - pv).norm() < 1e-6) continue;
+      const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(p.point[0], p.point[1], p.point[2]), c);
+      if ((to_eigen(nearest->point()) - p.point).norm() < 1e-6) continue;
+      if (!best || (p.point - pv).norm() > (best->point - pv).norm()) best = p;
+    }
+    if (!best) throw MeshingError("a sample of the skin has no triangle and no repair point was found");
+    ++stats_.inserted_topology;
+    insert(best->point, best->cell, v->cell());  // the next pass evaluates everything
+    clean = false;
+  }
+  return clean;
+}
+
+SurfaceMesh Refiner::extract(const std::vector<FacetEval>& restricted) const {
+  SurfaceMesh mesh;
+  std::vector<int> index(static_cast<size_t>(next_id_), -1);
+  for (const FacetEval& e : restricted) {
+    std::array<int, 3> t;
+    for (int k = 0; k < 3; ++k) {
+      const Vertex_handle v = e.v[static_cast<size_t>(k)];
+      int& slot = index[static_cast<size_t>(v->info().id)];
+      if (slot < 0) {
+        slot = static_cast<int>(mesh.vertices.size());
+        const Eigen::Vector3d p = to_eigen(v->point());
+        const SkinEval se = complex_.evaluate(p, v->info().cell);
+        mesh.vertices.push_back(p);
+        mesh.normals.push_back(se.gradient.normalized());
+        mesh.cells.push_back(se.cell);
+      }
+      t[static_cast<size_t>(k)] = slot;
+    }
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
+    const Eigen::Vector3d normal =
+        (mesh.vertices[static_cast<size_t>(t[1])] - a).cross(mesh.vertices[static_cast<size_t>(t[2])] - a);
+    if (normal.dot(e.outward) < 0) std::swap(t[1], t[2]);
+    mesh.triangles.push_back(t);
+  }
+  return mesh;
+}
+
+void Refiner::contract() {
+  // Filled in by the edge contraction step.
+}
+
+SkinMeshResult Refiner::run() {
+  const auto start = Clock::now();
+  report("seeding", true);
+  insert_seeds();
+  stats_.seconds_seeding = seconds_since(start);
+  const auto refine_start = Clock::now();
+  std::vector<FacetEval> restricted;
+  for (;;) {
+    report("checking", true);
+    const auto before = dt_.number_of_vertices();
+    if (global_pass(&restricted)) break;
+    refine();
+    check_budget();
+    // Every bad triangle found by a pass gets a new vertex unless its surface
+    // ball centre coincides with a sample, which only rounding can cause
+    // (flat Delaunay tetrahedra of cocircular samples). Say so, never spin.
+    if (dt_.number_of_vertices() == before)
+      throw MeshingError("refinement stalled: the bad triangles left have surface Delaunay ball centres at "
+                         "existing samples (numerically degenerate Delaunay tetrahedra)");
+  }
+  stats_.seconds_refining = seconds_since(refine_start);
+  if (options_.contract_below > 0) {
+    const auto contract_start = Clock::now();
+    report("cleaning", true);
+    contract();
+    stats_.seconds_contracting = seconds_since(contract_start);
+  }
+  SkinMeshResult result;
+  result.mesh = extract(restricted);
+  stats_.seconds_total = seconds_since(start);
+  result.stats = stats_;
+  return result;
+}
+
+}  // namespace
+
+double target_edge_length(const SkinComplex& complex, const Eigen::Vector3d& x, int cell,
+                          const MeshingOptions& options) {
+  const double base = options.edge_length > 0 ? options.edge_length : target_size(complex, x, cell, options.sizing);
+  // Sphere patches (vertex and tetrahedron cells) have constant curvature, so
+  // they need no floor against runaway refinement; without one, a tiny void
+  // (a concave sphere a thousandth of an Angstrom across, which real proteins
+  // have) is meshed as the closed component it is instead of one lost sample.
+  const int dim = complex.cell(cell).dim;
+  if (dim == 0 || dim == 3) return std::min(base, options.sizing.epsilon * local_length(complex, x, cell));
+  return base;
+}
+
+SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& options) {
+  if (!(options.min_angle > 0 && options.min_angle <= 30.0))
+    throw std::invalid_argument("the angle bound must be in (0, 30] degrees (Delaunay refinement "
+                                "terminates for bounds up to about 30 degrees)");
+  if (!(options.tolerance > 0)) throw std::invalid_argument("the distance tolerance must be positive");
+  if (!(options.edge_length >= 0)) throw std::invalid_argument("the edge length must be positive");
+  if (!(options.sizing.epsilon > 0) || !(options.sizing.min_size > 0) ||
+      !(options.sizing.max_size >= options.sizing.min_size))
+    throw std::invalid_argument("sizing: epsilon and min_size must be positive, max_size >= min_size");
+  if (options.max_triangles <= 0) throw std::invalid_argument("the triangle budget must be positive");
+  std::optional<tbb::global_control> threads;
+  if (options.threads > 0)
+    threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
+  Refiner refiner(complex, options);
+  return refiner.run();
+}
+
+}  // namespace skinmesh
