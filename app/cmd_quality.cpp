@@ -3,8 +3,8 @@
 #include "commands.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
+#include "quality_report.hpp"
 
-#include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/meshing/mesh_io.hpp"
 #include "skinmesh/meshing/mesh_quality.hpp"
 
@@ -15,73 +15,8 @@
 #include <iostream>
 
 namespace skinmesh::app {
-namespace {
 
 using json = nlohmann::json;
-
-json to_json(const MeshQuality& q) {
-  json valence = json::object();
-  for (const auto& [k, n] : q.valence) valence[std::to_string(k)] = n;
-  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-  return {{"vertices", q.vertices},
-          {"triangles", q.triangles},
-          {"edges", q.edges},
-          {"min_angle_deg", q.min_angle},
-          {"max_angle_deg", q.max_angle},
-          {"mean_min_angle_deg", q.mean_min_angle},
-          {"share_min_angle_below_20", q.share_below_20},
-          {"share_min_angle_below_10", q.share_below_10},
-          {"max_radius_edge_ratio", finite(q.max_radius_edge)},
-          {"max_aspect_ratio", finite(q.max_aspect)},
-          {"edge_length", {{"min", q.min_edge}, {"mean", q.mean_edge}, {"max", q.max_edge}}},
-          {"valence", valence},
-          {"area", q.area},
-          {"volume", q.volume},
-          {"components", q.components},
-          {"euler_characteristic", q.euler},
-          {"genus", q.genus >= 0 ? json(q.genus) : json(nullptr)},
-          {"closed", q.closed},
-          {"manifold", q.manifold},
-          {"consistently_oriented", q.oriented},
-          {"boundary_edges", q.boundary_edges},
-          {"nonmanifold_edges", q.nonmanifold_edges},
-          {"nonmanifold_vertices", q.nonmanifold_vertices},
-          {"inconsistent_edges", q.inconsistent_edges},
-          {"degenerate_triangles", q.degenerate_triangles},
-          {"unused_vertices", q.unused_vertices},
-          {"self_intersections_checked", q.self_intersections_checked},
-          {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
-          {"min_angle_histogram", {{"lo_deg", q.min_angle_histogram.lo},
-                                   {"hi_deg", q.min_angle_histogram.hi},
-                                   {"counts", q.min_angle_histogram.counts}}}};
-}
-
-// A bar chart of the smallest angle per triangle, written by the tool itself.
-void write_svg(std::ostream& out, const MeshQuality& q, const std::string& title) {
-  const auto& h = q.min_angle_histogram;
-  const long peak = std::max<long>(1, *std::max_element(h.counts.begin(), h.counts.end()));
-  const int width = 640, height = 360, left = 60, bottom = 300, plot_h = 240;
-  const double bar = (width - left - 20.0) / h.counts.size();
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
-      << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
-  out << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  out << "<text x=\"" << left << "\" y=\"24\" font-size=\"14\">Smallest angle per triangle: " << title << "</text>\n";
-  for (size_t i = 0; i < h.counts.size(); ++i) {
-    const double hgt = plot_h * static_cast<double>(h.counts[i]) / peak;
-    const double lo = h.lo + (h.hi - h.lo) * i / h.counts.size();
-    out << "<rect x=\"" << left + bar * i + 1 << "\" y=\"" << bottom - hgt << "\" width=\"" << bar - 2
-        << "\" height=\"" << hgt << "\" fill=\"" << (lo < 20 ? "#d95f02" : "#1b9e77") << "\"><title>" << lo << "-"
-        << lo + (h.hi - h.lo) / h.counts.size() << " deg: " << h.counts[i] << "</title></rect>\n";
-    out << "<text x=\"" << left + bar * i << "\" y=\"" << bottom + 16 << "\">" << lo << "</text>\n";
-  }
-  out << "<line x1=\"" << left << "\" y1=\"" << bottom << "\" x2=\"" << width - 20 << "\" y2=\"" << bottom
-      << "\" stroke=\"black\"/>\n";
-  out << "<text x=\"" << left << "\" y=\"" << bottom + 36 << "\">degrees (orange: below 20); " << q.triangles
-      << " triangles, min " << q.min_angle << " deg; tallest bar " << peak << "</text>\n";
-  out << "</svg>\n";
-}
-
-}  // namespace
 
 void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_code) {
   struct Options {
@@ -106,40 +41,18 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
     report["file"] = o->mesh;
     if (!o->molecule.path.empty()) {
       const Molecule m = read_molecule(o->molecule.path, o->molecule.read);
-      const SkinOracle oracle(balls_from_molecule(m, o->molecule.shrink, o->molecule.convention()), o->molecule.shrink);
-      double worst = 0, sum = 0;
-      for (const Eigen::Vector3d& v : mesh.vertices) {
-        const double d = oracle.evaluate(v).distance();
-        worst = std::max(worst, d);
-        sum += d;
-      }
-      report["on_surface_error"] = {{"molecule", o->molecule.path},
-                                    {"shrink", o->molecule.shrink},
-                                    {"weights", convention_name(o->molecule.convention())},
-                                    {"max", worst},
-                                    {"mean", mesh.vertices.empty() ? 0.0 : sum / mesh.vertices.size()}};
+      const auto balls = balls_from_molecule(m, o->molecule.shrink, o->molecule.convention());
+      json error = on_surface_error(mesh.vertices, balls, o->molecule.shrink);
+      error["molecule"] = o->molecule.path;
+      error["shrink"] = o->molecule.shrink;
+      error["weights"] = convention_name(o->molecule.convention());
+      report["on_surface_error"] = error;
     }
     if (!o->svg.empty()) write_file_atomically(o->svg, [&](std::ostream& out) { write_svg(out, q, o->mesh); });
     if (global.json) {
       std::cout << report.dump(2) << "\n";
     } else {
-      std::cout << o->mesh << ": " << q.vertices << " vertices, " << q.triangles << " triangles\n"
-                << "  angles:      min " << q.min_angle << ", max " << q.max_angle << " deg; "
-                << 100 * q.share_below_20 << "% of triangles under 20 deg, " << 100 * q.share_below_10
-                << "% under 10\n"
-                << "  ratios:      radius-edge max " << q.max_radius_edge << ", aspect max " << q.max_aspect << "\n"
-                << "  edges:       " << q.min_edge << " / " << q.mean_edge << " / " << q.max_edge << " A (min/mean/max)\n"
-                << "  size:        area " << q.area << " A^2, volume " << q.volume << " A^3\n"
-                << "  topology:    " << q.components << " component(s), Euler characteristic " << q.euler
-                << ", genus " << (q.genus >= 0 ? std::to_string(q.genus) : std::string("n/a")) << "\n"
-                << "  defects:     " << q.boundary_edges << " boundary edges, " << q.nonmanifold_edges
-                << " non-manifold edges, " << q.nonmanifold_vertices << " non-manifold vertices, "
-                << q.inconsistent_edges << " inconsistently oriented edges, " << q.degenerate_triangles
-                << " zero-area triangles\n"
-                << "  self-intersections: "
-                << (q.self_intersections_checked ? std::to_string(q.self_intersecting_pairs) + " pairs"
-                                                 : std::string("not checked (needs a manifold, oriented mesh)"))
-                << "\n";
+      print_quality_summary(std::cout, o->mesh, q);
       if (report.contains("on_surface_error"))
         std::cout << "  on-surface error: max " << report["on_surface_error"]["max"].get<double>() << " A, mean "
                   << report["on_surface_error"]["mean"].get<double>() << " A (oracle, " << o->molecule.path << ")\n";

@@ -12,5 +12,6 @@ struct GlobalOptions {
 // Each adds its subcommand to `app`; the callback runs it and sets `exit_code`.
 void add_info_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
+void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 
 }  // namespace skinmesh::app

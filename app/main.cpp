@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet,-q", global.quiet, "no progress or warnings on the terminal");
   int exit_code = 0;
   skinmesh::app::add_info_command(app, global, exit_code);
+  skinmesh::app::add_mesh_command(app, global, exit_code);
   skinmesh::app::add_quality_command(app, global, exit_code);
   try {
     app.parse(argc, argv);

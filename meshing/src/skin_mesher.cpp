@@ -41,6 +41,11 @@ using Cell_handle = Delaunay::Cell_handle;
 using Facet = Delaunay::Facet;
 using Clock = std::chrono::steady_clock;
 
+// The distance criterion measures the skin's deviation at one point of each
+// triangle (its circumcentre's normal line); the deviation elsewhere in the
+// triangle is a little larger, so the criterion keeps this margin.
+constexpr double kToleranceMargin = 0.7;
+
 Eigen::Vector3d to_eigen(const K::Point_3& p) { return {p.x(), p.y(), p.z()}; }
 
 enum class Defect { none, topology, size, distance, shape };
@@ -91,7 +96,6 @@ class Refiner {
   std::vector<Facet> star_facets(Vertex_handle v) const;  // after insert(v)
   std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
   bool global_pass(std::vector<FacetEval>* restricted);
-  void contract();
   SurfaceMesh extract(const std::vector<FacetEval>& restricted) const;
   void report(const char* stage, bool always = false);
   void check_budget() const;
@@ -122,6 +126,10 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
   e.stamp_c = c->info();
   e.stamp_n = c->neighbor(i)->info();
   for (int k = 0; k < 3; ++k) e.v[static_cast<size_t>(k)] = c->vertex((i + 1 + k) & 3);
+  // Canonical form, whichever cell the facet was reached from: vertices in
+  // insertion order and the Voronoi edge walked along +normal. Near-degenerate
+  // configurations then get the same answer in every pass and every process.
+  std::sort(e.v.begin(), e.v.end(), [](Vertex_handle x, Vertex_handle y) { return x->info().id < y->info().id; });
   const Eigen::Vector3d p0 = to_eigen(e.v[0]->point()), p1 = to_eigen(e.v[1]->point()),
                         p2 = to_eigen(e.v[2]->point());
   // The Voronoi edge lies on the line through the triangle's circumcentre along
@@ -146,18 +154,18 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
     return numerator / (2.0 * height);
   };
   const Eigen::Vector3d apex_c = to_eigen(c->vertex(i)->point());
-  const double lambda_a = end_parameter(apex_c);
+  double lambda_c = end_parameter(apex_c), lambda_n;
   const Cell_handle n = c->neighbor(i);
-  double lambda_b;
   std::optional<Eigen::Vector3d> apex_n;
   if (dt_.is_infinite(n)) {
     // Convex hull facet: the Voronoi edge is a ray leaving the hull.
-    lambda_b = normal.dot(apex_c - circumcenter) > 0 ? -reach : reach;
+    lambda_n = normal.dot(apex_c - circumcenter) > 0 ? -reach : reach;
   } else {
     apex_n = to_eigen(n->vertex(n->index(c))->point());
-    lambda_b = end_parameter(*apex_n);
+    lambda_n = end_parameter(*apex_n);
   }
-  const Eigen::Vector3d a = circumcenter + lambda_a * normal, b = circumcenter + lambda_b * normal;
+  const Eigen::Vector3d a = circumcenter + std::min(lambda_c, lambda_n) * normal,
+                        b = circumcenter + std::max(lambda_c, lambda_n) * normal;
   auto hits = complex_.intersect_segment(a, b, e.v[0]->info().cell);
   // A point inside the Voronoi edge is strictly nearer to the triangle's
   // vertices than to either apex. When a tetrahedron is flat (its apex
@@ -197,7 +205,7 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
   const double target = target_edge_length(complex_, e.center, e.cell, options_);
   if (e.radius > target / std::sqrt(3.0))
     e.defect = Defect::size;
-  else if ((e.center - circumcenter).norm() > options_.tolerance)
+  else if ((e.center - circumcenter).norm() > kToleranceMargin * options_.tolerance)
     e.defect = Defect::distance;
   else if (!(circumradius <= max_radius_edge_ * shortest))
     e.defect = Defect::shape;
@@ -471,10 +479,6 @@ SurfaceMesh Refiner::extract(const std::vector<FacetEval>& restricted) const {
   return mesh;
 }
 
-void Refiner::contract() {
-  // Filled in by the edge contraction step.
-}
-
 SkinMeshResult Refiner::run() {
   const auto start = Clock::now();
   report("seeding", true);
@@ -496,12 +500,6 @@ SkinMeshResult Refiner::run() {
                          "existing samples (numerically degenerate Delaunay tetrahedra)");
   }
   stats_.seconds_refining = seconds_since(refine_start);
-  if (options_.contract_below > 0) {
-    const auto contract_start = Clock::now();
-    report("cleaning", true);
-    contract();
-    stats_.seconds_contracting = seconds_since(contract_start);
-  }
   SkinMeshResult result;
   result.mesh = extract(restricted);
   stats_.seconds_total = seconds_since(start);

@@ -26,7 +26,7 @@
 namespace skinmesh {
 
 struct MeshingProgress {
-  const char* stage = "";      // "seeding", "refining", "checking", "cleaning"
+  const char* stage = "";      // "seeding", "refining", "checking"
   long vertices = 0;
   long pending = 0;            // bad triangles waiting in the queue
 };
@@ -41,10 +41,6 @@ struct MeshingOptions {
   // along the triangle's normal line (its Voronoi edge).
   double tolerance = 0.1;
   long max_triangles = 4'000'000;  // refinement stops with MeshingError past this
-  // Edge contraction after refinement: remove a vertex with an edge shorter than
-  // contract_below * target edge length when the triangles it leaves still meet
-  // every criterion. 0 turns it off.
-  double contract_below = 0.4;
   int threads = 0;             // 0: all hardware threads
   std::function<void(const MeshingProgress&)> progress;  // called now and then, from the calling thread
 };
@@ -53,10 +49,8 @@ struct MeshingStats {
   long seeds = 0;
   long inserted_size = 0, inserted_shape = 0, inserted_distance = 0;
   long inserted_topology = 0;      // Voronoi edges crossing twice, non-disk vertex stars, isolated samples
-  long contracted = 0;             // vertices removed by edge contraction
-  long contraction_rejected = 0;   // contractions undone because a criterion failed
   int passes = 0;                  // global verification passes over all Delaunay facets
-  double seconds_seeding = 0, seconds_refining = 0, seconds_contracting = 0, seconds_total = 0;
+  double seconds_seeding = 0, seconds_refining = 0, seconds_total = 0;
 };
 
 struct SkinMeshResult {

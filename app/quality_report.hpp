@@ -1,0 +1,29 @@
+// The quality report both `quality` and `mesh` print and write: grading as
+// JSON, the on-surface error by the oracle, the human summary and the SVG
+// histogram of smallest angles.
+#pragma once
+
+#include "skinmesh/core/balls.hpp"
+#include "skinmesh/meshing/mesh_quality.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace skinmesh::app {
+
+nlohmann::json to_json(const MeshQuality& q);
+
+// |F(x)| / |grad F(x)| for every vertex by the oracle of MATH.md section 2
+// (in parallel): {"max", "mean"}.
+nlohmann::json on_surface_error(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
+                                double shrink);
+
+void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q);
+
+// A bar chart of the smallest angle per triangle, written by the tool itself.
+void write_svg(std::ostream& out, const MeshQuality& q, const std::string& title);
+
+}  // namespace skinmesh::app

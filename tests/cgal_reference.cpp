@@ -1,0 +1,55 @@
+#include "cgal_reference.hpp"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polyhedron_3.h>
+#include <CGAL/make_skin_surface_mesh_3.h>
+
+#include <map>
+
+namespace skinmesh::test {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+SurfaceMesh cgal_skin_mesh(const std::vector<Ball>& balls, double shrink) {
+  std::vector<K::Weighted_point_3> points;
+  for (const Ball& b : balls) points.emplace_back(K::Point_3(b.center[0], b.center[1], b.center[2]), b.weight);
+  CGAL::Polyhedron_3<K> polyhedron;
+  CGAL::make_skin_surface_mesh_3(polyhedron, points.begin(), points.end(), shrink, 0, false);
+  SurfaceMesh mesh;
+  std::map<CGAL::Polyhedron_3<K>::Vertex_const_handle, int> index;
+  for (auto v = polyhedron.vertices_begin(); v != polyhedron.vertices_end(); ++v) {
+    index[v] = static_cast<int>(mesh.vertices.size());
+    mesh.vertices.emplace_back(v->point().x(), v->point().y(), v->point().z());
+  }
+  for (auto f = polyhedron.facets_begin(); f != polyhedron.facets_end(); ++f) {
+    auto h = f->facet_begin();
+    std::array<int, 3> t{};
+    for (int k = 0; k < 3; ++k, ++h) t[static_cast<size_t>(k)] = index[h->vertex()];
+    mesh.triangles.push_back(t);
+  }
+  return mesh;
+}
+
+std::vector<double> distances_to_mesh(const SurfaceMesh& mesh, const std::vector<Eigen::Vector3d>& points) {
+  using Triangle = K::Triangle_3;
+  using Iterator = std::vector<Triangle>::const_iterator;
+  using Primitive = CGAL::AABB_triangle_primitive<K, Iterator>;
+  using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+  std::vector<Triangle> triangles;
+  auto point = [&](int i) {
+    const Eigen::Vector3d& p = mesh.vertices[static_cast<size_t>(i)];
+    return K::Point_3(p[0], p[1], p[2]);
+  };
+  for (const auto& t : mesh.triangles) triangles.emplace_back(point(t[0]), point(t[1]), point(t[2]));
+  Tree tree(triangles.begin(), triangles.end());
+  tree.accelerate_distance_queries();
+  std::vector<double> out;
+  for (const Eigen::Vector3d& p : points)
+    out.push_back(std::sqrt(tree.squared_distance(K::Point_3(p[0], p[1], p[2]))));
+  return out;
+}
+
+}  // namespace skinmesh::test

@@ -1,0 +1,163 @@
+// The mesher's guarantees, each measured against something independent of
+// the mesher: the oracle of MATH.md section 2 (vertices on the skin), exact
+// grading (angles, manifold, orientation, CGAL self-intersection test) and
+// CGAL's certified skin mesher (components and Euler characteristic).
+#include "cgal_reference.hpp"
+#include "test_support.hpp"
+
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/meshing/mesh_quality.hpp"
+#include "skinmesh/meshing/openmesh_mesh.hpp"
+#include "skinmesh/meshing/skin_mesher.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace skinmesh;
+using namespace skinmesh::test;
+
+namespace {
+
+Ball ball(double x, double y, double z, double skin_radius, double s = 0.5) {
+  return {Eigen::Vector3d(x, y, z), skin_radius * skin_radius / s};
+}
+
+// Meshes `balls` and checks every guarantee of the mesher issue.
+void check_guarantees(const std::vector<Ball>& balls, const std::string& label, const MeshingOptions& options = {},
+                      double s = 0.5) {
+  INFO(label);
+  const SkinComplex complex = build_skin_complex(balls, {s});
+  const SkinMeshResult result = mesh_skin(complex, options);
+  const SurfaceMesh& mesh = result.mesh;
+  const MeshQuality q = grade_mesh(mesh);
+  REQUIRE(q.triangles > 0);
+
+  // Every triangle's smallest angle at least the bound.
+  CHECK(q.min_angle >= options.min_angle - 1e-9);
+
+  // Every vertex on the skin within 1e-9 A, by the oracle.
+  const SkinOracle oracle(balls, s);
+  double worst = 0;
+  for (const Eigen::Vector3d& v : mesh.vertices) worst = std::max(worst, oracle.evaluate(v).distance());
+  CHECK(worst <= 1e-9);
+
+  // Closed, consistently oriented (outward: positive volume) 2-manifold
+  // without self-intersections.
+  CHECK(q.closed);
+  CHECK(q.manifold);
+  CHECK(q.oriented);
+  CHECK(q.volume > 0);
+  CHECK(q.self_intersections_checked);
+  CHECK(q.self_intersecting_pairs == 0);
+  CHECK(q.degenerate_triangles == 0);
+
+  // The topology of CGAL's certified skin mesh of the same balls.
+  const MeshQuality reference = grade_mesh(cgal_skin_mesh(balls, s), GradeOptions{false});
+  CHECK(q.components == reference.components);
+  CHECK(q.euler == reference.euler);
+
+  // Every point of the skin within the tolerance of the mesh: exact skin
+  // points (projected, then certified by the oracle) against the mesh.
+  std::vector<Eigen::Vector3d> skin_points;
+  for (const Eigen::Vector3d& x : sample_near_balls(balls, s, 3000, 0.5, 7)) {
+    const Projection p = complex.project(x);
+    if (p.converged && oracle.evaluate(p.point).distance() <= 1e-9) skin_points.push_back(p.point);
+  }
+  REQUIRE(skin_points.size() > 2000);
+  double farthest = 0;
+  for (double d : distances_to_mesh(mesh, skin_points)) farthest = std::max(farthest, d);
+  CHECK(farthest <= options.tolerance);
+
+  // The OpenMesh view of the mesh holds the same closed surface.
+  const SkinTriMesh om = to_openmesh(mesh);
+  CHECK(om.n_faces() == mesh.triangles.size());
+  long boundary = 0;
+  for (const auto h : om.halfedges())
+    if (om.is_boundary(h)) ++boundary;
+  CHECK(boundary == 0);
+}
+
+std::vector<Ball> molecule_balls(const std::string& path) {
+  return balls_from_molecule(read_molecule(path), 0.5, WeightConvention::GrowBySkin);
+}
+
+}  // namespace
+
+TEST_CASE("mesher guarantees on the shipped molecules", "[mesher]") {
+  for (const char* name : {"pept.pdb", "3al1.pdb", "1ubi.pdb"}) check_guarantees(molecule_balls(data_file(name)), name);
+}
+
+TEST_CASE("mesher guarantees on the shared PDB files", "[mesher]") {
+  for (const char* name : {"1ejg.pdb", "2k39_3models.pdb"}) check_guarantees(molecule_balls(shared_pdb(name)), name);
+}
+
+TEST_CASE("mesher guarantees on the large shared PDB files", "[mesher][slow]") {
+  for (const char* name : {"1hpv.pdb", "3mht.pdb"}) check_guarantees(molecule_balls(shared_pdb(name)), name);
+}
+
+TEST_CASE("mesher guarantees on adversarial ball sets", "[mesher]") {
+  const double w = 1.5 * 1.5 / 0.5;   // weight of a ball whose lone skin has radius 1.5
+  const double touch = 2 * std::sqrt(w);  // centre distance at which two such skins pinch
+  check_guarantees({ball(0, 0, 0, 1.5), ball(touch * 1.01, 0, 0, 1.5)}, "two balls just apart");
+  check_guarantees({ball(0, 0, 0, 1.5), ball(touch * 0.995, 0, 0, 1.5)}, "two balls with a thin neck");
+  check_guarantees({ball(0, 0, 0, 2.0), ball(0.3, 0.1, 0, 0.8)}, "a ball swallowed by another");
+  {
+    // Four balls on a regular tetrahedron (edge 3) leaving a void of radius
+    // about 0.26 A at its centre: the orthogonal sphere has R2 = 0.135 > 0
+    // while every edge and face sphere has R2 < 0.
+    const double a = 3.0, weight = 0.36 * a * a;
+    std::vector<Ball> four;
+    for (const Eigen::Vector3d& d : {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1), Eigen::Vector3d(-1, 1, -1),
+                                     Eigen::Vector3d(-1, -1, 1)})
+      four.push_back({d * a / std::sqrt(8.0), weight});
+    check_guarantees(four, "four balls around a tiny void");
+  }
+  {
+    std::vector<Ball> line;
+    for (int i = 0; i < 5; ++i) line.push_back(ball(1.6 * i, 0, 0, 1.2));
+    check_guarantees(line, "atoms on a line");
+  }
+  {
+    std::vector<Ball> far = molecule_balls(data_file("pept.pdb"));
+    far.push_back(ball(60, 60, 60, 1.7));
+    check_guarantees(far, "an isolated atom far away");
+  }
+}
+
+TEST_CASE("mesher options: uniform edge length, a smaller angle bound, the budget", "[mesher]") {
+  const auto balls = molecule_balls(data_file("pept.pdb"));
+  MeshingOptions uniform;
+  uniform.edge_length = 0.6;
+  check_guarantees(balls, "uniform edge length 0.6 A", uniform);
+
+  MeshingOptions loose;
+  loose.min_angle = 20;
+  check_guarantees(balls, "angle bound 20 degrees", loose);
+
+  const SkinComplex complex = build_skin_complex(balls, {0.5});
+  MeshingOptions tiny;
+  tiny.max_triangles = 1000;
+  CHECK_THROWS_AS(mesh_skin(complex, tiny), MeshingError);
+  MeshingOptions bad;
+  bad.min_angle = 35;
+  CHECK_THROWS_AS(mesh_skin(complex, bad), std::invalid_argument);
+}
+
+TEST_CASE("mesh vertices carry their mixed cell and outward normal", "[mesher]") {
+  const auto balls = molecule_balls(data_file("pept.pdb"));
+  const SkinComplex complex = build_skin_complex(balls, {0.5});
+  const SkinMeshResult r = mesh_skin(complex);
+  REQUIRE(r.mesh.cells.size() == r.mesh.vertices.size());
+  REQUIRE(r.mesh.normals.size() == r.mesh.vertices.size());
+  const SkinOracle oracle(balls, 0.5);
+  for (size_t v = 0; v < r.mesh.vertices.size(); v += 7) {
+    const Eigen::Vector3d& x = r.mesh.vertices[v];
+    // The stored cell holds the vertex (up to rounding on its boundary).
+    CHECK(complex.membership_violation(r.mesh.cells[v], x) <= 1e-9);
+    // The normal is the oracle's outward gradient direction.
+    CHECK(r.mesh.normals[v].dot(oracle.evaluate(x).gradient.normalized()) == Approx(1.0).margin(1e-9));
+  }
+}
