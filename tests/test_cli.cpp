@@ -100,3 +100,54 @@ TEST_CASE("skinmesh quality grades a mesh file, writes an SVG, measures on-surfa
   CHECK(missing.code == 2);
   CHECK(missing.output.find("/nonexistent/mesh.off") != std::string::npos);
 }
+
+TEST_CASE("skinmesh mesh writes a mesh, a report and MSMS files; failures leave nothing behind", "[cli][mesh]") {
+  skinmesh::test::TempFile out("pept.ply");
+  const std::string report = out.path() + ".json";
+  const Run r = run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + out.path() + " --report " + report +
+                    " --quiet");
+  INFO(r.output);
+  CHECK(r.code == 0);
+  std::ifstream ply(out.path(), std::ios::binary);
+  std::string line;
+  std::getline(ply, line);
+  CHECK(line == "ply");
+  std::getline(ply, line);
+  CHECK(line == "format binary_little_endian 1.0");
+  std::getline(ply, line);
+  std::getline(ply, line);
+  std::getline(ply, line);
+  CHECK(line == "property double x");  // full precision by default
+  std::ifstream rep(report);
+  const std::string json((std::istreambuf_iterator<char>(rep)), std::istreambuf_iterator<char>());
+  CHECK(json.find("\"closed_oriented_manifold\": true") != std::string::npos);
+  CHECK(json.find("\"min_angle_at_least_bound\": true") != std::string::npos);
+  std::remove(report.c_str());
+
+  // The same mesh, graded by `quality` from the written file.
+  const Run q = run("quality " + out.path() + " --molecule " + skinmesh::test::data_file("pept.pdb") + " --json");
+  CHECK(q.code == 0);
+  CHECK(q.output.find("\"components\": 3") != std::string::npos);
+
+  skinmesh::test::TempFile vert("pept.vert");
+  const std::string face = vert.path().substr(0, vert.path().size() - 5) + ".face";
+  CHECK(run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + vert.path() + " --quiet").code == 0);
+  CHECK(std::ifstream(face).good());
+  std::remove(face.c_str());
+
+  // Over budget: an error naming the molecule, exit 3, no file.
+  skinmesh::test::TempFile none("none.off");
+  std::remove(none.path().c_str());
+  const Run budget = run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + none.path() + " --max-triangles 500");
+  CHECK(budget.code == 3);
+  CHECK(budget.output.find("pept.pdb") != std::string::npos);
+  CHECK(budget.output.find("budget") != std::string::npos);
+  CHECK_FALSE(std::ifstream(none.path()).good());
+
+  const Run format = run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + none.path() + ".xyz");
+  CHECK(format.code != 0);
+  CHECK(format.output.find(".xyz") != std::string::npos);
+  const Run missing = run("mesh /nonexistent/x.pdb -o " + none.path());
+  CHECK(missing.code == 2);
+  CHECK_FALSE(std::ifstream(none.path()).good());
+}

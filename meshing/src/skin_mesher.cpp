@@ -232,7 +232,19 @@ void Refiner::check_budget() const {
                        "--edge-length, --tolerance)");
 }
 
-Vertex_handle Refiner::insert(const Eigen::Vector3d& p, int cell, Cell_handle hint) {
+Vertex_handle Refiner::insert(const Eigen::Vector3d& point, int cell, Cell_handle hint) {
+  // A crossing is a root of the cell's quadric, so it is on the skin to
+  // rounding; where that root is ill-conditioned (a nearly tangent Voronoi
+  // edge, a tiny sphere far from the origin) one projection step restores it.
+  Eigen::Vector3d p = point;
+  const SkinEval check = complex_.evaluate(p, cell);
+  if (std::abs(check.value) > 1e-13 * check.gradient.norm()) {
+    const Projection polished = complex_.project(p, check.cell, 1e-14);
+    if (polished.converged) {
+      p = polished.point;
+      cell = polished.cell;
+    }
+  }
   const Vertex_handle v = dt_.insert(K::Point_3(p[0], p[1], p[2]), hint);
   if (v->info().id < 0) {
     v->info().cell = cell;
