@@ -97,7 +97,7 @@ class Refiner {
   std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
   bool global_pass(std::vector<FacetEval>* restricted);
   SurfaceMesh extract(const std::vector<FacetEval>& restricted) const;
-  void report(const char* stage, bool always = false);
+  void report(const char* stage, bool always = false, long pending = 0);
   void check_budget() const;
 
   const SkinComplex& complex_;
@@ -212,14 +212,14 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
   return e;
 }
 
-void Refiner::report(const char* stage, bool always) {
+void Refiner::report(const char* stage, bool always, long pending) {
   if (!options_.progress) return;
   if (!always && seconds_since(last_report_) < 0.25) return;
   last_report_ = Clock::now();
   MeshingProgress p;
   p.stage = stage;
   p.vertices = static_cast<long>(dt_.number_of_vertices());
-  p.pending = static_cast<long>(pending_.size());
+  p.pending = pending;
   options_.progress(p);
 }
 
@@ -358,9 +358,7 @@ void Refiner::refine() {
     }
     if ((next_id_ & 1023) == 0) {
       check_budget();
-      pending_.resize(queue.size());  // only its size is reported
-      report("refining");
-      pending_.clear();
+      report("refining", false, static_cast<long>(queue.size()));
     }
   }
 }
