@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace skinmesh {
 namespace {
@@ -149,6 +150,23 @@ SkinEval SkinComplex::evaluate(const Eigen::Vector3d& x, int hint) const {
   return e;
 }
 
+std::optional<SegmentCrossing> SkinComplex::nearest_crossing_on_rays(const Eigen::Vector3d& x0, double reach,
+                                                                     int hint) const {
+  constexpr int kDirections = 64;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  std::optional<SegmentCrossing> best;
+  for (int i = 0; i < kDirections; ++i) {
+    // Fibonacci sphere: nearly uniform directions.
+    const double z = 1.0 - (2.0 * i + 1.0) / kDirections;
+    const double rho = std::sqrt(1.0 - z * z);
+    const Eigen::Vector3d u(rho * std::cos(golden * i), rho * std::sin(golden * i), z);
+    const double limit = best ? (best->point - x0).norm() : reach;
+    const auto hits = intersect_segment(x0, x0 + limit * u, hint);
+    if (!hits.empty()) best = hits.front();
+  }
+  return best;
+}
+
 Projection SkinComplex::project_onto(const Eigen::Vector3d& x0, int hint, double tolerance) const {
   constexpr int kMaxIterations = 60;
   constexpr double kMaxStep = 2.0;    // Angstrom: a Newton step longer than this is damped
@@ -173,6 +191,18 @@ Projection SkinComplex::project_onto(const Eigen::Vector3d& x0, int hint, double
     if (!hits.empty()) {
       out.point = hits.front().point;
       out.cell = hits.front().cell;
+    } else {
+      // Inside the body F can have a saddle or a maximum below zero along the
+      // gradient line, and Newton's iteration then runs to a critical point
+      // of F. Cast rays in evenly spread directions and start from the
+      // nearest crossing instead. Inside, look as far as kMaxReach (a point
+      // deeper in a packed interior stays unprojected: converged = false);
+      // outside, stay local, or a far point would snap onto any other piece.
+      const double ray_reach = start.value < 0 ? kMaxReach : reach;
+      if (const auto nearest = nearest_crossing_on_rays(x0, ray_reach, start.cell)) {
+        out.point = nearest->point;
+        out.cell = nearest->cell;
+      }
     }
   }
   // Newton polish (one step on an exact crossing), or the whole way when the

@@ -29,11 +29,14 @@ struct Problem {
   const std::vector<Ball>& balls;
   double s;
   Eigen::Vector3d x;
-  // Objective phi(l) = (1-s)|x - Z l|^2 + s sum l_i pi_i(x); gradient entry i:
-  // g_i = -2(1-s) <x - Z l, z_i> + s pi_i(x).
+  // Objective phi(l) = (1-s)|x - Z l|^2 + s sum l_i pi_i(x). On the simplex
+  // x - Z l = -(Z - x 1^T) l, so we differentiate in centres relative to x,
+  // which keeps every term the size of the local geometry instead of the
+  // size of the coordinates (~100 A): gradient entry i is
+  // g_i = -2(1-s) <x - Z l, z_i - x> + s pi_i(x).
   double gradient_entry(int i, const Eigen::Vector3d& r) const {
     const Ball& b = balls[static_cast<size_t>(i)];
-    return -2 * (1 - s) * r.dot(b.center) + s * b.power(x);
+    return -2 * (1 - s) * r.dot(b.center - x) + s * b.power(x);
   }
 };
 
@@ -64,35 +67,39 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
     for (int a = 0; a < k; ++a) y += l[a] * p.balls[static_cast<size_t>(S[a])].center;
     const Eigen::Vector3d r = p.x - y;
     Eigen::VectorXd g(k);
+    // Centres relative to x: the objective only sees x - Z l, and with
+    // coordinates ~100 A the absolute Gram matrix has entries ~1e4 that are
+    // nearly equal, which makes the KKT system look singular when it is not.
     Eigen::MatrixXd Z(3, k);
     for (int a = 0; a < k; ++a) {
       g[a] = p.gradient_entry(S[a], r);
-      Z.col(a) = p.balls[static_cast<size_t>(S[a])].center;
+      Z.col(a) = p.balls[static_cast<size_t>(S[a])].center - p.x;
     }
-    // Equality-constrained step on S: [2(1-s) Z^T Z, -1; 1^T, 0] [step; mu] = [-g; 0].
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(k + 1, k + 1);
-    M.topLeftCorner(k, k) = 2 * (1 - s) * Z.transpose() * Z;
-    M.block(0, k, k, 1).setConstant(-1.0);
-    M.block(k, 0, 1, k).setConstant(1.0);
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(k + 1);
-    rhs.head(k) = -g;
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(M);
-    lu.setThreshold(1e-12);
+    // The KKT system below is singular exactly when the centres of S are
+    // affinely dependent: [Z; 1^T] d = 0 has a non-zero solution.
+    Eigen::MatrixXd A(4, k);
+    A.topRows(3) = Z;
+    A.row(3).setOnes();
+    Eigen::FullPivLU<Eigen::MatrixXd> dependence(A);
+    dependence.setThreshold(1e-10);
+    const bool singular = dependence.rank() < k;
     Eigen::VectorXd step;
     double mu = 0;
-    bool singular = !lu.isInvertible();
     if (!singular) {
-      const Eigen::VectorXd sol = lu.solve(rhs);
+      // Equality-constrained step on S: [2(1-s) Z^T Z, -1; 1^T, 0] [step; mu] = [-g; 0].
+      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(k + 1, k + 1);
+      M.topLeftCorner(k, k) = 2 * (1 - s) * Z.transpose() * Z;
+      M.block(0, k, k, 1).setConstant(-1.0);
+      M.block(k, 0, 1, k).setConstant(1.0);
+      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(k + 1);
+      rhs.head(k) = -g;
+      const Eigen::VectorXd sol = M.fullPivLu().solve(rhs);
       step = sol.head(k);
       mu = sol[k];
     } else {
       // Affinely dependent centres: along a direction d with sum d = 0 and
       // Z d = 0 the objective is linear; go downhill until a weight reaches 0.
-      Eigen::MatrixXd A(4, k);
-      A.topRows(3) = Z;
-      A.row(3).setOnes();
-      Eigen::FullPivLU<Eigen::MatrixXd> kernel_lu(A);
-      Eigen::VectorXd d = kernel_lu.kernel().col(0);
+      Eigen::VectorXd d = dependence.kernel().col(0);
       if (g.dot(d) > 0) d = -d;
       step = d * 1e30;  // unbounded along d: the ratio test below stops it
     }
@@ -170,7 +177,9 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
       wsum += sol.lambda[a];
     }
     mu /= wsum;
-    const double scale = 1.0 + std::abs(mu) + 2 * (1 - shrink_) * r.norm() * (x.norm() + 1.0);
+    double reach = 1.0;
+    for (int i : sol.support) reach = std::max(reach, (balls_[static_cast<size_t>(i)].center - x).norm());
+    const double scale = 1.0 + std::abs(mu) + 2 * (1 - shrink_) * r.norm() * reach;
     double violation = 0;
     for (int i : sol.support) violation = std::max(violation, std::abs(p.gradient_entry(i, r) - mu) / scale);
     std::vector<int> violators;

@@ -439,20 +439,30 @@ bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
     }
   }
   // A sample with no restricted triangle: the skin around it escapes every
-  // Voronoi edge of its cell. Add the skin point nearest to the farthest
-  // Voronoi vertex of the cell; the triangulation then sees that piece.
+  // Voronoi edge of its cell. Add a skin point inside that Voronoi cell (the
+  // projection of one of its Voronoi vertices, the farthest from the sample);
+  // the triangulation then sees that piece. A projection that lands in another
+  // sample's cell is used only when none stays in this one: it does not
+  // split this cell, so repeating it can go on for ever (a 0.005 A void of
+  // 1ubi does that when its Voronoi vertices project onto the outer skin).
   for (const Vertex_handle& v : isolated) {
     std::vector<Cell_handle> cells;
     dt_.incident_cells(v, std::back_inserter(cells));
     const Eigen::Vector3d pv = to_eigen(v->point());
     std::optional<Projection> best;
+    bool best_in_cell = false;
     for (const Cell_handle& c : cells) {
       if (dt_.is_infinite(c)) continue;
       const Projection p = complex_.project(to_eigen(dt_.dual(c)), v->info().cell);
       if (!p.converged || (p.point - pv).norm() < 1e-6) continue;
       const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(p.point[0], p.point[1], p.point[2]), c);
       if ((to_eigen(nearest->point()) - p.point).norm() < 1e-6) continue;
-      if (!best || (p.point - pv).norm() > (best->point - pv).norm()) best = p;
+      const bool in_cell = nearest == v;
+      if (!best || (in_cell && !best_in_cell) ||
+          (in_cell == best_in_cell && (p.point - pv).norm() > (best->point - pv).norm())) {
+        best = p;
+        best_in_cell = in_cell;
+      }
     }
     if (!best) throw MeshingError("a sample of the skin has no triangle and no repair point was found");
     ++stats_.inserted_topology;

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace skinmesh {
@@ -113,6 +114,7 @@ class SkinComplex {
   friend SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options);
   int start_cell(const Eigen::Vector3d& x) const;
   Projection project_onto(const Eigen::Vector3d& x, int hint, double tolerance) const;
+  std::optional<SegmentCrossing> nearest_crossing_on_rays(const Eigen::Vector3d& x, double reach, int hint) const;
   int locate_by_search(const Eigen::Vector3d& x) const;
 
   double shrink_ = 0.5;
