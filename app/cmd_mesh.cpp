@@ -123,7 +123,7 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code
     GradeOptions grade;
     grade.check_self_intersections = !o->no_self_intersections;
     const MeshQuality q = grade_mesh(result.mesh, grade);
-    json error = on_surface_error(result.mesh.vertices, balls, o->molecule.shrink);
+    json error = on_surface_error_json(result.mesh.vertices, balls, o->molecule.shrink);
     const double seconds_grading = seconds_since(grade_start);
 
     // The guarantees, measured on the mesh about to be written.

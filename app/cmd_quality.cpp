@@ -42,7 +42,7 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
     if (!o->molecule.path.empty()) {
       const Molecule m = read_molecule(o->molecule.path, o->molecule.read);
       const auto balls = balls_from_molecule(m, o->molecule.shrink, o->molecule.convention());
-      json error = on_surface_error(mesh.vertices, balls, o->molecule.shrink);
+      json error = on_surface_error_json(mesh.vertices, balls, o->molecule.shrink);
       error["molecule"] = o->molecule.path;
       error["shrink"] = o->molecule.shrink;
       error["weights"] = convention_name(o->molecule.convention());

@@ -1,17 +1,11 @@
 #include "quality_report.hpp"
 
-#include "skinmesh/core/skin_oracle.hpp"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
 
 namespace skinmesh::app {
-
 
 nlohmann::json to_json(const MeshQuality& q) {
   using json = nlohmann::json;
@@ -76,22 +70,10 @@ void write_svg(std::ostream& out, const MeshQuality& q, const std::string& title
 }
 
 
-nlohmann::json on_surface_error(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
-                                double shrink) {
-  const SkinOracle oracle(balls, shrink);
-  using Pair = std::pair<double, double>;  // max, sum
-  const Pair r = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, vertices.size(), 1024), Pair{0.0, 0.0},
-      [&](const tbb::blocked_range<size_t>& range, Pair acc) {
-        for (size_t i = range.begin(); i != range.end(); ++i) {
-          const double d = oracle.evaluate(vertices[i]).distance();
-          acc.first = std::max(acc.first, d);
-          acc.second += d;
-        }
-        return acc;
-      },
-      [](Pair a, Pair b) { return Pair{std::max(a.first, b.first), a.second + b.second}; });
-  return {{"max", r.first}, {"mean", vertices.empty() ? 0.0 : r.second / vertices.size()}};
+nlohmann::json on_surface_error_json(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
+                                     double shrink) {
+  const SurfaceError e = on_surface_error(vertices, balls, shrink);
+  return {{"max", e.max}, {"mean", e.mean}, {"uncertified", e.uncertified}};
 }
 
 void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q) {

@@ -16,10 +16,9 @@ namespace skinmesh::app {
 
 nlohmann::json to_json(const MeshQuality& q);
 
-// |F(x)| / |grad F(x)| for every vertex by the oracle of MATH.md section 2
-// (in parallel): {"max", "mean"}.
-nlohmann::json on_surface_error(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
-                                double shrink);
+// skinmesh::on_surface_error as JSON: {"max", "mean", "uncertified"}.
+nlohmann::json on_surface_error_json(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
+                                     double shrink);
 
 void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q);
 

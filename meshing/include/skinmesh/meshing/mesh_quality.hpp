@@ -4,6 +4,7 @@
 // triangles) and self-intersections.
 #pragma once
 
+#include "skinmesh/core/balls.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 
 #include <map>
@@ -50,5 +51,14 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options = {}
 // the number of intersecting triangle pairs, or -1 when the mesh cannot be
 // built as a manifold surface.
 long count_self_intersections(const SurfaceMesh& mesh);
+
+// Distance of each vertex from the skin of `balls`, |F(x)| / |grad F(x)| by the
+// oracle of MATH.md section 2 (independent of the mixed complex), in parallel.
+struct SurfaceError {
+  double max = 0.0, mean = 0.0;  // Angstrom
+  long uncertified = 0;          // vertices where the oracle could not certify its answer
+};
+SurfaceError on_surface_error(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
+                              double shrink);
 
 }  // namespace skinmesh
