@@ -71,8 +71,14 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code
                   "curvature-relative size: edge length / local radius of curvature")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--edge-length", o->meshing.edge_length, "uniform target edge length in Angstrom (instead of --epsilon)")
+  cmd->add_option("--edge-length", o->meshing.edge_length,
+                  "largest edge length in Angstrom, uniform wherever the curvature allows it (--epsilon still "
+                  "bounds it where the skin bends more, which keeps the topology)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--contract-below", o->meshing.contract_below,
+                  "clean-up: contract edges shorter than this times the local target length (0: off)")
+      ->check(CLI::Range(0.0, 0.99))
+      ->capture_default_str();
   cmd->add_option("--min-size", o->meshing.sizing.min_size, "smallest target edge length on hyperboloid patches, A")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -152,6 +158,7 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code
           {"min_size", meshing.sizing.min_size},
           {"max_size", meshing.sizing.max_size},
           {"tolerance", meshing.tolerance},
+          {"contract_below", meshing.contract_below},
           {"max_triangles", meshing.max_triangles}}},
         {"quality", to_json(q)},
         {"on_surface_error", error},
@@ -162,11 +169,14 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code
           {"inserted_for_distance", s.inserted_distance},
           {"inserted_for_angle", s.inserted_shape},
           {"inserted_for_topology", s.inserted_topology},
-          {"passes", s.passes}}},
+          {"passes", s.passes},
+          {"contracted_edges", s.contracted},
+          {"contraction_attempts", s.contraction_attempts}}},
         {"seconds",
          {{"complex", seconds_complex},
           {"seeding", s.seconds_seeding},
           {"refining", s.seconds_refining},
+          {"contracting", s.seconds_contracting},
           {"meshing", s.seconds_total},
           {"grading", seconds_grading}}}};
 

@@ -1,118 +1,12 @@
-// Restricted Delaunay refinement of the skin (see skin_mesher.hpp). This is the
-// only translation unit that sees the 3D Delaunay triangulation.
+// Restricted Delaunay refinement of the skin (see skin_mesher.hpp): facet
+// evaluation, seeding, refinement, the global checks and the extraction of
+// the mesh. The clean-up by edge contraction is in edge_contraction.cpp.
 #include "skinmesh/meshing/skin_mesher.hpp"
 
+#include "refiner.hpp"
 #include "skin_seeds.hpp"
 
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Delaunay_triangulation_cell_base_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_cell_base_with_info_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
-#include <Eigen/Geometry>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <limits>
-#include <optional>
-#include <queue>
-#include <tuple>
-#include <unordered_map>
-
-namespace skinmesh {
-namespace {
-
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-struct VertexInfo {
-  int cell = -1;  // mixed cell of the sample (a hint for every walk that starts near it)
-  int id = -1;    // insertion order
-};
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<VertexInfo, K>;
-// Cell info: a stamp that changes whenever the cell is (re)created, so that an
-// evaluation of a facet can tell whether its Voronoi edge is still the same.
-using Cb = CGAL::Triangulation_cell_base_with_info_3<unsigned, K, CGAL::Delaunay_triangulation_cell_base_3<K>>;
-using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
-using Delaunay = CGAL::Delaunay_triangulation_3<K, Tds>;
-using Vertex_handle = Delaunay::Vertex_handle;
-using Cell_handle = Delaunay::Cell_handle;
-using Facet = Delaunay::Facet;
-using Clock = std::chrono::steady_clock;
-
-// The distance criterion measures the skin's deviation at one point of each
-// triangle (its circumcentre's normal line); the deviation elsewhere in the
-// triangle is a little larger, so the criterion keeps this margin.
-constexpr double kToleranceMargin = 0.7;
-
-Eigen::Vector3d to_eigen(const K::Point_3& p) { return {p.x(), p.y(), p.z()}; }
-
-enum class Defect { none, topology, size, distance, shape };
-
-// What the Voronoi edge dual to one Delaunay facet says about it.
-struct FacetEval {
-  int crossings = 0;                 // of the Voronoi edge with the skin; restricted iff > 0
-  Eigen::Vector3d center;            // surface Delaunay ball centre (farthest crossing if several)
-  int cell = -1;                     // its mixed cell
-  double radius = 0;                 // surface Delaunay ball radius
-  Eigen::Vector3d outward;           // outward skin normal direction along the Voronoi edge
-  Defect defect = Defect::none;
-  bool force = false;                // a vertex-star repair: insert even without a defect
-  std::array<Vertex_handle, 3> v;
-  unsigned stamp_c = 0, stamp_n = 0; // of the two cells when evaluated
-};
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-class Refiner {
- public:
-  Refiner(const SkinComplex& complex, const MeshingOptions& options) : complex_(complex), options_(options) {
-    // The skin lies inside the union of the input balls: rays beyond this box miss it.
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector3d hi = -lo;
-    double max_radius = 0;
-    for (const Ball& b : complex.balls()) {
-      lo = lo.cwiseMin(b.center);
-      hi = hi.cwiseMax(b.center);
-      max_radius = std::max(max_radius, std::sqrt(std::max(0.0, b.weight)));
-    }
-    box_center_ = 0.5 * (lo + hi);
-    box_radius_ = 0.5 * (hi - lo).norm() + max_radius + 1.0;
-    const double angle = options.min_angle * M_PI / 180.0;
-    max_radius_edge_ = 1.0 / (2.0 * std::sin(angle));
-  }
-
-  SkinMeshResult run();
-
- private:
-  FacetEval evaluate(const Facet& facet) const;
-  void insert_seeds();
-  Vertex_handle insert(const Eigen::Vector3d& p, int cell, Cell_handle hint);
-  void push_if_bad(FacetEval e, bool force = false);
-  void refine();
-  std::vector<Facet> star_facets(Vertex_handle v) const;  // after insert(v)
-  std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
-  bool global_pass(std::vector<FacetEval>* restricted);
-  SurfaceMesh extract(const std::vector<FacetEval>& restricted) const;
-  void report(const char* stage, bool always = false, long pending = 0);
-  void check_budget() const;
-
-  const SkinComplex& complex_;
-  const MeshingOptions& options_;
-  Delaunay dt_;
-  std::vector<FacetEval> pending_;   // bad facets waiting for their surface ball centre
-  std::vector<Cell_handle> star_;    // cells made by the last insertion
-  unsigned stamp_ = 0;
-  Eigen::Vector3d box_center_;
-  double box_radius_ = 0;
-  double max_radius_edge_ = 1;
-  int next_id_ = 0;
-  MeshingStats stats_;
-  Clock::time_point last_report_ = Clock::now();
-};
+namespace skinmesh::detail {
 
 FacetEval Refiner::evaluate(const Facet& facet) const {
   Cell_handle c = facet.first;
@@ -123,8 +17,8 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
     c = m;
   }
   FacetEval e;
-  e.stamp_c = c->info();
-  e.stamp_n = c->neighbor(i)->info();
+  e.stamp_c = c->info().value;
+  e.stamp_n = c->neighbor(i)->info().value;
   for (int k = 0; k < 3; ++k) e.v[static_cast<size_t>(k)] = c->vertex((i + 1 + k) & 3);
   // Canonical form, whichever cell the facet was reached from: vertices in
   // insertion order and the Voronoi edge walked along +normal. Near-degenerate
@@ -251,7 +145,7 @@ Vertex_handle Refiner::insert(const Eigen::Vector3d& point, int cell, Cell_handl
     v->info().id = next_id_++;
     star_.clear();
     dt_.incident_cells(v, std::back_inserter(star_));
-    for (const Cell_handle& c : star_) c->info() = ++stamp_;
+    for (const Cell_handle& c : star_) c->info().value = ++stamp_;
   }
   return v;
 }
@@ -326,7 +220,8 @@ void Refiner::refine() {
     int i0, i1, i2;
     if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) continue;
     const Cell_handle n = c->neighbor(6 - i0 - i1 - i2);
-    if (!((c->info() == e.stamp_c && n->info() == e.stamp_n) || (c->info() == e.stamp_n && n->info() == e.stamp_c))) {
+    const unsigned sc = c->info().value, sn = n->info().value;
+    if (!((sc == e.stamp_c && sn == e.stamp_n) || (sc == e.stamp_n && sn == e.stamp_c))) {
       const bool force = e.force;
       e = evaluate(Facet(c, 6 - i0 - i1 - i2));  // its Voronoi edge changed: look again
       if (e.crossings > 0 && (e.defect != Defect::none || force)) {
@@ -363,20 +258,69 @@ void Refiner::refine() {
   }
 }
 
+bool is_single_cycle(const std::vector<std::pair<int, int>>& edges) {
+  if (edges.empty()) return false;
+  // One cycle: every link vertex has degree two and a walk visits every edge.
+  std::unordered_map<int, std::array<int, 2>> adjacent;
+  for (const auto& [a, b] : edges) {
+    for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}}) {
+      auto [it, fresh] = adjacent.try_emplace(x, std::array<int, 2>{{y, -1}});
+      if (!fresh) {
+        if (it->second[1] >= 0) return false;
+        it->second[1] = y;
+      }
+    }
+  }
+  for (const auto& [x, ys] : adjacent)
+    if (ys[1] < 0) return false;
+  int prev = edges[0].first, cur = edges[0].second;
+  size_t steps = 1;
+  while (cur != edges[0].first && steps <= edges.size()) {
+    const auto& ys = adjacent[cur];
+    const int next = ys[0] == prev ? ys[1] : ys[0];
+    prev = cur;
+    cur = next;
+    ++steps;
+  }
+  return steps == edges.size();
+}
+
 // Classifies every Delaunay facet (in parallel), queues the bad ones and the
 // repairs of vertex stars that are not disks. Returns true when nothing is left
 // to do; then `restricted` holds the restricted facets.
 bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
   ++stats_.passes;
+  // A facet whose two cells are older than the previous pass has the same
+  // Voronoi edge, hence the same evaluation: take it from that pass (restricted
+  // facets are kept; any other unchanged facet was not restricted). Only the
+  // facets of new cells are evaluated again.
   std::vector<Facet> facets;
-  facets.reserve(dt_.number_of_finite_facets());
-  for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) facets.push_back(*f);
-  const std::vector<FacetEval> evals = evaluate_all(facets);
   restricted->clear();
+  for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) {
+    if (have_pass_cache_) {
+      const Cell_handle c = f->first, n = c->neighbor(f->second);
+      if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
+        FacetKey key;
+        for (int k = 0; k < 3; ++k) key[static_cast<size_t>(k)] = c->vertex((f->second + 1 + k) & 3)->info().id;
+        std::sort(key.begin(), key.end());
+        const auto it = pass_cache_.find(key);
+        if (it != pass_cache_.end()) restricted->push_back(it->second);
+        continue;
+      }
+    }
+    facets.push_back(*f);
+  }
+  const std::vector<FacetEval> evals = evaluate_all(facets);
+  for (const FacetEval& e : evals)
+    if (e.crossings > 0) restricted->push_back(e);
+  pass_cache_.clear();
+  pass_cache_.reserve(restricted->size());
+  for (const FacetEval& e : *restricted)
+    pass_cache_.emplace(FacetKey{{e.v[0]->info().id, e.v[1]->info().id, e.v[2]->info().id}}, e);
+  last_pass_stamp_ = stamp_;
+  have_pass_cache_ = true;
   bool clean = true;
-  for (const FacetEval& e : evals) {
-    if (e.crossings == 0) continue;
-    restricted->push_back(e);
+  for (const FacetEval& e : *restricted) {
     if (e.defect != Defect::none) {
       push_if_bad(e);
       clean = false;
@@ -407,32 +351,7 @@ bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
       isolated.push_back(v);
       continue;
     }
-    // One cycle: every link vertex has degree two and a walk visits every edge.
-    std::unordered_map<int, std::array<int, 2>> adjacent;
-    bool ok = true;
-    for (const auto& [a, b] : edges) {
-      for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}}) {
-        auto [it, fresh] = adjacent.try_emplace(x, std::array<int, 2>{{y, -1}});
-        if (!fresh) {
-          if (it->second[1] >= 0) ok = false;
-          it->second[1] = y;
-        }
-      }
-    }
-    for (const auto& [x, ys] : adjacent)
-      if (ys[1] < 0) ok = false;
-    if (ok) {
-      int prev = edges[0].first, cur = edges[0].second;
-      size_t steps = 1;
-      while (cur != edges[0].first && steps <= edges.size()) {
-        const auto& ys = adjacent[cur];
-        const int next = ys[0] == prev ? ys[1] : ys[0];
-        prev = cur;
-        cur = next;
-        ++steps;
-      }
-      ok = steps == edges.size();
-    }
+    const bool ok = is_single_cycle(edges);
     if (!ok) {
       push_if_bad((*restricted)[static_cast<size_t>(best_facet[static_cast<size_t>(id)])], true);
       clean = false;
@@ -499,17 +418,12 @@ SurfaceMesh Refiner::extract(const std::vector<FacetEval>& restricted) const {
   return mesh;
 }
 
-SkinMeshResult Refiner::run() {
-  const auto start = Clock::now();
-  report("seeding", true);
-  insert_seeds();
-  stats_.seconds_seeding = seconds_since(start);
-  const auto refine_start = Clock::now();
-  std::vector<FacetEval> restricted;
+// Global passes and refinement until a pass finds nothing to do.
+void Refiner::refine_until_clean(std::vector<FacetEval>* restricted) {
   for (;;) {
     report("checking", true);
     const auto before = dt_.number_of_vertices();
-    if (global_pass(&restricted)) break;
+    if (global_pass(restricted)) return;
     refine();
     check_budget();
     // Every bad triangle found by a pass gets a new vertex unless its surface
@@ -519,7 +433,27 @@ SkinMeshResult Refiner::run() {
       throw MeshingError("refinement stalled: the bad triangles left have surface Delaunay ball centres at "
                          "existing samples (numerically degenerate Delaunay tetrahedra)");
   }
+}
+
+SkinMeshResult Refiner::run() {
+  const auto start = Clock::now();
+  report("seeding", true);
+  insert_seeds();
+  stats_.seconds_seeding = seconds_since(start);
+  const auto refine_start = Clock::now();
+  std::vector<FacetEval> restricted;
+  refine_until_clean(&restricted);
   stats_.seconds_refining = seconds_since(refine_start);
+  // Clean-up: contract short edges (one round: a contraction blocks its
+  // neighbourhood for the round, and further rounds found few more), then
+  // check globally and refine again if that finds anything (it should not:
+  // each contraction is checked locally).
+  if (options_.contract_below > 0) {
+    const auto contract_start = Clock::now();
+    report("contracting", true);
+    if (contract_short_edges(restricted) > 0) refine_until_clean(&restricted);
+    stats_.seconds_contracting = seconds_since(contract_start);
+  }
   SkinMeshResult result;
   result.mesh = extract(restricted);
   stats_.seconds_total = seconds_since(start);
@@ -527,11 +461,18 @@ SkinMeshResult Refiner::run() {
   return result;
 }
 
-}  // namespace
+}  // namespace skinmesh::detail
+
+namespace skinmesh {
 
 double target_edge_length(const SkinComplex& complex, const Eigen::Vector3d& x, int cell,
                           const MeshingOptions& options) {
-  const double base = options.edge_length > 0 ? options.edge_length : target_size(complex, x, cell, options.sizing);
+  // The curvature-relative size is what keeps the topology (a sample dense
+  // with respect to the local radius of curvature sees every handle and
+  // neck); a requested edge length can only make triangles smaller. A
+  // strictly uniform 1 A mesh of 1ubi loses one of its 68 handles.
+  double base = target_size(complex, x, cell, options.sizing);
+  if (options.edge_length > 0) base = std::min(base, options.edge_length);
   // Sphere patches (vertex and tetrahedron cells) have constant curvature, so
   // they need no floor against runaway refinement; without one, a tiny void
   // (a concave sphere a thousandth of an Angstrom across, which real proteins
@@ -551,10 +492,12 @@ SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& optio
       !(options.sizing.max_size >= options.sizing.min_size))
     throw std::invalid_argument("sizing: epsilon and min_size must be positive, max_size >= min_size");
   if (options.max_triangles <= 0) throw std::invalid_argument("the triangle budget must be positive");
+  if (!(options.contract_below >= 0 && options.contract_below < 1))
+    throw std::invalid_argument("the contraction threshold must be in [0, 1) times the target edge length");
   std::optional<tbb::global_control> threads;
   if (options.threads > 0)
     threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
-  Refiner refiner(complex, options);
+  detail::Refiner refiner(complex, options);
   return refiner.run();
 }
 

@@ -33,13 +33,20 @@ struct MeshingProgress {
 
 struct MeshingOptions {
   double min_angle = 30.0;     // degrees: every triangle's smallest angle at least this (at most 30)
-  // Sizing: a uniform target edge length in Angstrom when > 0, else the
-  // curvature-relative sizing (edge ~ epsilon / max |curvature|, clamped).
+  // Sizing: the curvature-relative size (edge ~ epsilon / max |curvature|,
+  // clamped to [min_size, max_size]), capped at edge_length (Angstrom) when
+  // that is > 0. The cap never loosens the curvature bound, which is what
+  // keeps the topology.
   double edge_length = 0.0;
   SizingOptions sizing;
   // Largest distance (Angstrom) between a triangle's circumcentre and the skin
   // along the triangle's normal line (its Voronoi edge).
   double tolerance = 0.1;
+  // Clean-up (Cheng-Shi): restricted edges shorter than this times the local
+  // target edge length are contracted to a skin point when every guarantee
+  // still holds around them; 0 (the default) leaves it out. Measured on 1hpv:
+  // 0.5 contracts 1,817 edges, 2% fewer triangles, for 45% more meshing time.
+  double contract_below = 0.0;
   long max_triangles = 4'000'000;  // refinement stops with MeshingError past this
   int threads = 0;             // 0: all hardware threads
   std::function<void(const MeshingProgress&)> progress;  // called now and then, from the calling thread
@@ -50,7 +57,9 @@ struct MeshingStats {
   long inserted_size = 0, inserted_shape = 0, inserted_distance = 0;
   long inserted_topology = 0;      // Voronoi edges crossing twice, non-disk vertex stars, isolated samples
   int passes = 0;                  // global verification passes over all Delaunay facets
-  double seconds_seeding = 0, seconds_refining = 0, seconds_total = 0;
+  long contracted = 0;             // short edges contracted by the clean-up
+  long contraction_attempts = 0;   // short edges tried (the others would have broken a guarantee)
+  double seconds_seeding = 0, seconds_refining = 0, seconds_contracting = 0, seconds_total = 0;
 };
 
 struct SkinMeshResult {
