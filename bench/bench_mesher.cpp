@@ -16,7 +16,8 @@
 // vertex with the oracle of MATH.md section 2. Prints JSON lines, then a
 // markdown table, then the ratios.
 //
-//   bench_mesher [--edge-length L] [--timeout S] [--skip-surface-mesher] [FILE...]
+//   bench_mesher [--edge-length L] [--timeout S] [--skip-surface-mesher] [--only TEXT] [FILE...]
+//   (--only: run the methods whose name contains TEXT)
 //   (default files: data/pept.pdb, data/1ubi.pdb, ../shared/data/pdb/1hpv.pdb, 3mht.pdb)
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
@@ -226,14 +227,18 @@ int main(int argc, char** argv) {
   double edge_length = 1.0;
   int timeout = 900;
   bool surface_mesher = true;
+  std::string only;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--edge-length" && i + 1 < argc) edge_length = std::atof(argv[++i]);
     else if (a == "--timeout" && i + 1 < argc) timeout = std::max(1, std::atoi(argv[++i]));
     else if (a == "--skip-surface-mesher") surface_mesher = false;
+    else if (a == "--only" && i + 1 < argc) only = argv[++i];
     else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "usage: bench_mesher [--edge-length L] [--timeout S] [--skip-surface-mesher] [FILE...]\n");
+      std::fprintf(stderr,
+                   "usage: bench_mesher [--edge-length L] [--timeout S] [--skip-surface-mesher] [--only TEXT] "
+                   "[FILE...]\n");
       return 2;
     } else files.push_back(a);
   }
@@ -272,6 +277,7 @@ int main(int argc, char** argv) {
     if (surface_mesher)
       methods.emplace_back(sm, [&] { return cgal_surface_mesher(balls, edge_length / std::sqrt(3.0), 0.1); });
     for (const auto& [method, make] : methods) {
+      if (!only.empty() && method.find(only) == std::string::npos) continue;
       std::fprintf(stderr, "%s: %s ...\n", name.c_str(), method.c_str());
       Row row{name, method, run_in_child(timeout, balls, make)};
       print_json(row, atoms_of[name], baseline);
