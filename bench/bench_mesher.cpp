@@ -19,20 +19,18 @@
 //   bench_mesher [--edge-length L] [--timeout S] [--skip-surface-mesher] [--only TEXT] [FILE...]
 //   (--only: run the methods whose name contains TEXT)
 //   (default files: data/pept.pdb, data/1ubi.pdb, ../shared/data/pdb/1hpv.pdb, 3mht.pdb)
+#include "cgal_reference.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/meshing/mesh_quality.hpp"
 #include "skinmesh/meshing/skin_mesher.hpp"
 
 #include <CGAL/Complex_2_in_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
 #include <CGAL/Implicit_surface_3.h>
-#include <CGAL/Polyhedron_3.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/Surface_mesh_default_criteria_3.h>
 #include <CGAL/Surface_mesh_default_triangulation_3.h>
-#include <CGAL/make_skin_surface_mesh_3.h>
 #include <CGAL/make_surface_mesh.h>
 
 #include <algorithm>
@@ -127,14 +125,7 @@ Outcome run_in_child(int timeout_seconds, const std::vector<Ball>& balls,
   return out;
 }
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-
-std::vector<K::Weighted_point_3> weighted_points(const std::vector<Ball>& balls) {
-  std::vector<K::Weighted_point_3> points;
-  for (const Ball& b : balls) points.emplace_back(K::Point_3(b.center[0], b.center[1], b.center[2]), b.weight);
-  return points;
-}
-
+// A CGAL face graph (here the Surface_mesh of Surface_mesher's output) as a SurfaceMesh.
 template <class Mesh>
 SurfaceMesh from_face_graph(const Mesh& m) {
   SurfaceMesh out;
@@ -152,13 +143,6 @@ SurfaceMesh from_face_graph(const Mesh& m) {
     if (k == 3) out.triangles.push_back(t);
   }
   return out;
-}
-
-SurfaceMesh cgal_skin(const std::vector<Ball>& balls, int subdivisions) {
-  const auto points = weighted_points(balls);
-  CGAL::Polyhedron_3<K> polyhedron;
-  CGAL::make_skin_surface_mesh_3(polyhedron, points.begin(), points.end(), kShrink, subdivisions, false);
-  return from_face_graph(polyhedron);
 }
 
 // CGAL's Surface_mesher on F (our mixed complex evaluates it exactly; the
@@ -271,8 +255,8 @@ int main(int argc, char** argv) {
         {"skinmesh adaptive 1 thread", [&] { return ours(balls, 0.0, 1); }},
         {"skinmesh adaptive + contraction", [&] { return ours(balls, 0.0, 0, 0.5); }},
         {uniform, [&] { return ours(balls, edge_length, 0); }},
-        {"CGAL skin 0 subdiv", [&] { return cgal_skin(balls, 0); }},
-        {"CGAL skin 1 subdiv", [&] { return cgal_skin(balls, 1); }},
+        {"CGAL skin 0 subdiv", [&] { return test::cgal_skin_mesh(balls, kShrink, 0); }},
+        {"CGAL skin 1 subdiv", [&] { return test::cgal_skin_mesh(balls, kShrink, 1); }},
     };
     if (surface_mesher)
       methods.emplace_back(sm, [&] { return cgal_surface_mesher(balls, edge_length / std::sqrt(3.0), 0.1); });

@@ -13,11 +13,11 @@ namespace skinmesh::test {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 
-SurfaceMesh cgal_skin_mesh(const std::vector<Ball>& balls, double shrink) {
+SurfaceMesh cgal_skin_mesh(const std::vector<Ball>& balls, double shrink, int subdivisions) {
   std::vector<K::Weighted_point_3> points;
   for (const Ball& b : balls) points.emplace_back(K::Point_3(b.center[0], b.center[1], b.center[2]), b.weight);
   CGAL::Polyhedron_3<K> polyhedron;
-  CGAL::make_skin_surface_mesh_3(polyhedron, points.begin(), points.end(), shrink, 0, false);
+  CGAL::make_skin_surface_mesh_3(polyhedron, points.begin(), points.end(), shrink, subdivisions, false);
   SurfaceMesh mesh;
   std::map<CGAL::Polyhedron_3<K>::Vertex_const_handle, int> index;
   for (auto v = polyhedron.vertices_begin(); v != polyhedron.vertices_end(); ++v) {

@@ -1,7 +1,12 @@
 // The skinmesh command: exit codes and messages a user sees.
+#include "cgal_reference.hpp"
 #include "test_support.hpp"
 
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/meshing/mesh_write.hpp"
+
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <cmath>
@@ -99,6 +104,41 @@ TEST_CASE("skinmesh quality grades a mesh file, writes an SVG, measures on-surfa
   const Run missing = run("quality /nonexistent/mesh.off");
   CHECK(missing.code == 2);
   CHECK(missing.output.find("/nonexistent/mesh.off") != std::string::npos);
+}
+
+TEST_CASE("skinmesh quality grades CGAL's skin mesh and ours side by side", "[cli][quality]") {
+  using skinmesh::test::TempFile;
+  const std::string molecule = skinmesh::test::data_file("pept.pdb");
+  const auto balls = skinmesh::balls_from_molecule(skinmesh::read_molecule(molecule), 0.5);
+  TempFile cgal("cgal.off");
+  {
+    std::ofstream out(cgal.path());
+    skinmesh::write_mesh(out, skinmesh::test::cgal_skin_mesh(balls, 0.5), skinmesh::MeshFormat::off, nullptr);
+  }
+  TempFile ours("ours.off");
+  REQUIRE(run("--quiet mesh " + molecule + " -o " + ours.path()).code == 0);
+  auto grade = [&](const std::string& path) {
+    const Run r = run("--json quality " + path + " --molecule " + molecule);
+    INFO(r.output);
+    REQUIRE(r.code == 0);
+    return nlohmann::json::parse(r.output);
+  };
+  const nlohmann::json c = grade(cgal.path()), o = grade(ours.path());
+  INFO("CGAL: " << c.dump() << "\nskinmesh: " << o.dump());
+  // Both are closed manifolds without self-intersections, with the skin's topology.
+  for (const nlohmann::json* q : {&c, &o}) {
+    CHECK((*q)["closed"] == true);
+    CHECK((*q)["manifold"] == true);
+    CHECK((*q)["self_intersecting_pairs"] == 0);
+  }
+  CHECK(o["components"] == c["components"]);
+  CHECK(o["genus"] == c["genus"]);
+  // What the grader tells apart: only ours keeps the angle bound and has its
+  // vertices on the skin.
+  CHECK(o["min_angle_deg"].get<double>() >= 30.0 - 1e-9);
+  CHECK(c["min_angle_deg"].get<double>() < 30.0);
+  CHECK(o["on_surface_error"]["max"].get<double>() <= 1e-9);
+  CHECK(c["on_surface_error"]["max"].get<double>() > 1e-9);
 }
 
 TEST_CASE("skinmesh mesh writes a mesh, a report and MSMS files; failures leave nothing behind", "[cli][mesh]") {

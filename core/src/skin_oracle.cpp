@@ -145,11 +145,13 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
   const Problem p{balls_, shrink_, x};
   const int n = static_cast<int>(balls_.size());
   // Candidates: the balls of smallest power distance at x.
+  std::vector<double> power(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) power[static_cast<size_t>(i)] = balls_[static_cast<size_t>(i)].power(x);
   std::vector<int> order(static_cast<size_t>(n));
   std::iota(order.begin(), order.end(), 0);
   const int first = std::min(n, 24);
-  std::partial_sort(order.begin(), order.begin() + first, order.end(),
-                    [&](int a, int b) { return balls_[a].power(x) < balls_[b].power(x); });
+  std::nth_element(order.begin(), order.begin() + (first - 1), order.end(),
+                   [&](int a, int b) { return power[static_cast<size_t>(a)] < power[static_cast<size_t>(b)]; });
   std::vector<int> candidates(order.begin(), order.begin() + first);
 
   OracleResult out;

@@ -120,6 +120,8 @@ class Refiner {
   std::vector<Facet> star_facets(Vertex_handle v) const;  // after insert(v)
   std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
   bool global_pass(std::vector<FacetEval>* restricted);
+  bool repair_stars(const std::vector<FacetEval>& restricted, const std::vector<Vertex_handle>& vertices);
+  void local_passes();
   SurfaceMesh extract(const std::vector<FacetEval>& restricted) const;
   void report(const char* stage, bool always = false, long pending = 0);
   void refine_until_clean(std::vector<FacetEval>* restricted);
@@ -139,6 +141,7 @@ class Refiner {
   Delaunay dt_;
   std::vector<FacetEval> pending_;   // bad facets waiting for their surface ball centre
   std::vector<Cell_handle> star_;    // cells made by the last insertion
+  std::vector<Vertex_handle> recent_;  // inserted since the last global or local pass
   unsigned stamp_ = 0;
   // The restricted facets of the last global pass, by vertex ids, and the
   // stamp then: cells stamped no later are unchanged since.
