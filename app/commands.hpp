@@ -13,5 +13,6 @@ struct GlobalOptions {
 void add_info_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
+void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 
 }  // namespace skinmesh::app

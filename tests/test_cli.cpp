@@ -191,3 +191,28 @@ TEST_CASE("skinmesh mesh writes a mesh, a report and MSMS files; failures leave 
   CHECK(missing.code == 2);
   CHECK_FALSE(std::ifstream(none.path()).good());
 }
+
+TEST_CASE("skinmesh volume writes VTU, Gmsh and TetGen files with a report", "[cli][volume]") {
+  skinmesh::test::TempFile report("volume.json");
+  const std::string stem = report.path() + ".mesh";
+  const Run r = run("--quiet volume " + skinmesh::test::data_file("pept.pdb") + " -o " + stem +
+                    " --domain both --box-margin 4 --report " + report.path());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  for (const char* ext : {".vtu", ".msh", ".node", ".ele", ".face"}) {
+    std::ifstream in(stem + ext);
+    CHECK(in.good());
+    std::remove((stem + ext).c_str());
+  }
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(report.path()));
+  CHECK(j["inverted"] == 0);
+  CHECK(j["regions"].contains("interior"));
+  CHECK(j["regions"].contains("solvent"));
+  CHECK(j["regions"].contains("cavity"));
+  CHECK(j["interior_volume_relative_difference"].get<double>() <= 1e-9);
+
+  const Run bad = run("volume " + skinmesh::test::data_file("pept.pdb") + " -o " + stem + " --domain inside");
+  CHECK(bad.code != 0);
+  std::ifstream none(stem + ".vtu");
+  CHECK(!none.good());
+}

@@ -1,0 +1,151 @@
+// skinmesh volume: a tetrahedral mesh of the molecule's interior, of the
+// solvent between its skin and a box, or of both, bounded by the quality skin
+// mesh; written as TetGen's files, VTK (.vtu) and Gmsh (.msh), with a report.
+#include "commands.hpp"
+#include "molecule_options.hpp"
+#include "output_file.hpp"
+#include "quality_report.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/meshing/mesh_quality.hpp"
+#include "skinmesh/meshing/skin_mesher.hpp"
+#include "skinmesh/meshing/volume_mesh.hpp"
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+
+namespace skinmesh::app {
+
+void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_code) {
+  struct Options {
+    MoleculeOptions molecule;
+    std::string output, report;
+    MeshingOptions meshing;
+    VolumeOptions volume;
+    std::string domain = "interior";
+    bool drop_cavities = false;
+  };
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("volume", "tetrahedral mesh of the molecule's interior and/or the solvent (TetGen)");
+  add_molecule_options(*cmd, o->molecule);
+  cmd->add_option("--output,-o", o->output, "output stem: writes STEM.vtu, STEM.msh, STEM.node/.ele/.face")->required();
+  cmd->add_option("--report", o->report, "write the report as JSON");
+  cmd->add_option("--domain", o->domain, "interior, exterior (solvent up to a box) or both")
+      ->check(CLI::IsMember({"interior", "exterior", "both"}))
+      ->capture_default_str();
+  cmd->add_option("--box-margin", o->volume.box_margin, "Angstrom between the skin's bounding box and the outer box")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--max-radius-edge", o->volume.max_radius_edge, "largest circumradius / shortest edge of a tetrahedron")
+      ->check(CLI::Range(1.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option("--min-dihedral", o->volume.min_dihedral, "smallest dihedral angle, degrees")
+      ->check(CLI::Range(0.0, 16.0))
+      ->capture_default_str();
+  cmd->add_option("--max-volume", o->volume.max_volume, "largest tetrahedron, A^3 (0: no bound)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--drop-cavities", o->drop_cavities, "fill enclosed voids instead of keeping their surfaces");
+  cmd->add_option("--epsilon", o->meshing.sizing.epsilon, "surface: edge length / local radius of curvature")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--edge-length", o->meshing.edge_length, "surface: largest edge length, A")->check(CLI::PositiveNumber);
+  cmd->callback([o, &global, &exit_code]() {
+    const bool progress = !global.quiet && !global.json;
+    const Molecule m = read_molecule(o->molecule.path, o->molecule.read);
+    if (m.atoms.empty()) throw InputError(o->molecule.path, 0, "no atoms left to mesh");
+    const auto balls = balls_from_molecule(m, o->molecule.shrink, o->molecule.convention());
+    const SkinComplex complex = build_skin_complex(balls, {o->molecule.shrink});
+    if (progress) std::cerr << "skinmesh: meshing the skin\n";
+    SkinMeshResult surface;
+    try {
+      surface = mesh_skin(complex, o->meshing);
+    } catch (const MeshingError& e) {
+      std::cerr << "skinmesh: error: " << o->molecule.path << ": " << e.what() << "\n";
+      exit_code = 3;
+      return;
+    }
+    const MeshQuality sq = grade_mesh(surface.mesh);
+    if (!(sq.closed && sq.manifold && sq.oriented && sq.self_intersecting_pairs == 0)) {
+      std::cerr << "skinmesh: error: " << o->molecule.path << ": the skin mesh is not a closed, oriented, "
+                << "self-intersection-free manifold; no volume mesh\n";
+      exit_code = 3;
+      return;
+    }
+    VolumeOptions volume = o->volume;
+    volume.domain = o->domain == "both"       ? VolumeDomain::both
+                    : o->domain == "exterior" ? VolumeDomain::exterior
+                                              : VolumeDomain::interior;
+    volume.keep_cavities = !o->drop_cavities;
+    if (progress) std::cerr << "skinmesh: " << surface.mesh.triangles.size() << " skin triangles; running TetGen\n";
+    TetMesh tets;
+    try {
+      tets = tetrahedralize(surface.mesh, volume);
+    } catch (const VolumeMeshError& e) {
+      std::cerr << "skinmesh: error: " << o->molecule.path << ": " << e.what() << "\n";
+      exit_code = 3;
+      return;
+    }
+    const TetQuality q = grade_tet_mesh(tets);
+    // The interior's tetrahedra fill exactly what the skin encloses (its
+    // outer components minus kept cavities).
+    double enclosed = 0;
+    for (const auto& t : surface.mesh.triangles) {
+      const auto& a = surface.mesh.vertices[static_cast<size_t>(t[0])];
+      enclosed += a.dot(surface.mesh.vertices[static_cast<size_t>(t[1])].cross(surface.mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
+    }
+    std::map<int, long> per_region;
+    for (int r : tets.tet_region) ++per_region[r];
+    nlohmann::json regions = nlohmann::json::object();
+    for (const auto& [r, n] : per_region)
+      regions[r == kRegionInterior ? "interior" : r == kRegionSolvent ? "solvent" : r == kRegionCavity ? "cavity" : "other"] =
+          {{"tetrahedra", n}, {"volume", region_volume(tets, r)}};
+    const double interior = region_volume(tets, kRegionInterior);
+    nlohmann::json report = {
+        {"molecule", o->molecule.path},
+        {"domain", o->domain},
+        {"surface", to_json(sq)},
+        {"tetrahedra", q.tets},
+        {"points", q.points},
+        {"min_dihedral_deg", q.min_dihedral},
+        {"max_dihedral_deg", q.max_dihedral},
+        {"max_radius_edge_ratio", q.max_radius_edge},
+        {"max_radius_edge_ratio_off_boundary", q.max_radius_edge_off_boundary},
+        {"inverted", q.inverted},
+        {"regions", regions},
+        {"enclosed_volume", enclosed},
+        {"bounds_met", q.max_radius_edge <= volume.max_radius_edge && q.min_dihedral >= volume.min_dihedral},
+        {"outputs", {o->output + ".vtu", o->output + ".msh", o->output + ".node", o->output + ".ele", o->output + ".face"}}};
+    if (volume.domain != VolumeDomain::exterior)
+      report["interior_volume_relative_difference"] = std::abs(interior - enclosed) / enclosed;
+    write_file_atomically(o->output + ".vtu", [&](std::ostream& out) { write_vtu(out, tets); });
+    write_file_atomically(o->output + ".msh", [&](std::ostream& out) { write_gmsh(out, tets); });
+    write_file_atomically(o->output + ".node", [&](std::ostream& out) { write_tetgen_node(out, tets); });
+    write_file_atomically(o->output + ".ele", [&](std::ostream& out) { write_tetgen_ele(out, tets); });
+    write_file_atomically(o->output + ".face", [&](std::ostream& out) { write_tetgen_face(out, tets); });
+    if (!o->report.empty())
+      write_file_atomically(o->report, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+    if (global.json) {
+      std::cout << report.dump(2) << "\n";
+    } else if (!global.quiet) {
+      std::cout << o->output << ".{vtu,msh,node,ele,face}: " << q.tets << " tetrahedra, " << q.points << " points ("
+                << o->domain << ")\n"
+                << "  dihedral angles: " << q.min_dihedral << " - " << q.max_dihedral << " deg; radius-edge max "
+                << q.max_radius_edge << " (" << q.max_radius_edge_off_boundary << " away from the surface); "
+                << q.inverted << " inverted\n";
+      for (const auto& [name, r] : regions.items())
+        std::cout << "  region " << name << ": " << r["tetrahedra"].get<long>() << " tetrahedra, volume "
+                  << r["volume"].get<double>() << " A^3\n";
+      std::cout << "  skin: " << sq.triangles << " triangles, closed oriented manifold, "
+                << sq.self_intersecting_pairs << " self-intersections, encloses " << enclosed << " A^3\n";
+    }
+    exit_code = 0;
+  });
+}
+
+}  // namespace skinmesh::app

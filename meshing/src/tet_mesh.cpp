@@ -1,0 +1,187 @@
+// Grading and writing tetrahedral meshes (see volume_mesh.hpp).
+#include "skinmesh/meshing/volume_mesh.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace skinmesh {
+namespace {
+
+double tet_volume(const TetMesh& m, const std::array<int, 4>& t) {
+  const Eigen::Vector3d& a = m.points[static_cast<size_t>(t[0])];
+  return (m.points[static_cast<size_t>(t[1])] - a)
+             .dot((m.points[static_cast<size_t>(t[2])] - a).cross(m.points[static_cast<size_t>(t[3])] - a)) /
+         6.0;
+}
+
+std::string number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+}  // namespace
+
+double region_volume(const TetMesh& mesh, int region) {
+  double v = 0;
+  for (size_t i = 0; i < mesh.tets.size(); ++i)
+    if (mesh.tet_region[i] == region) v += tet_volume(mesh, mesh.tets[i]);
+  return v;
+}
+
+TetQuality grade_tet_mesh(const TetMesh& mesh) {
+  TetQuality q;
+  q.points = static_cast<long>(mesh.points.size());
+  q.tets = static_cast<long>(mesh.tets.size());
+  q.min_dihedral = 180;
+  std::vector<char> on_boundary(mesh.points.size(), 0);
+  for (const auto& f : mesh.faces)
+    for (int v : f) on_boundary[static_cast<size_t>(v)] = 1;
+  for (const auto& t : mesh.tets) {
+    const double v = tet_volume(mesh, t);
+    q.volume += v;
+    if (!(v > 0)) {
+      ++q.inverted;
+      continue;
+    }
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = mesh.points[static_cast<size_t>(t[static_cast<size_t>(k)])];
+    // Circumcentre relative to p0: 2 (p_i - p0) . c = |p_i - p0|^2.
+    Eigen::Matrix3d A;
+    Eigen::Vector3d rhs;
+    for (int i = 1; i < 4; ++i) {
+      A.row(i - 1) = 2.0 * (p[i] - p[0]).transpose();
+      rhs[i - 1] = (p[i] - p[0]).squaredNorm();
+    }
+    const double radius = A.fullPivLu().solve(rhs).norm();
+    double shortest = INFINITY;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) shortest = std::min(shortest, (p[i] - p[j]).norm());
+    q.max_radius_edge = std::max(q.max_radius_edge, radius / shortest);
+    if (!on_boundary[static_cast<size_t>(t[0])] && !on_boundary[static_cast<size_t>(t[1])] &&
+        !on_boundary[static_cast<size_t>(t[2])] && !on_boundary[static_cast<size_t>(t[3])])
+      q.max_radius_edge_off_boundary = std::max(q.max_radius_edge_off_boundary, radius / shortest);
+    // Outward normal of the face opposite each vertex.
+    Eigen::Vector3d n[4];
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d& a = p[(k + 1) % 4];
+      const Eigen::Vector3d& b = p[(k + 2) % 4];
+      const Eigen::Vector3d& c = p[(k + 3) % 4];
+      n[k] = (b - a).cross(c - a).normalized();
+      if (n[k].dot(p[k] - a) > 0) n[k] = -n[k];
+    }
+    // The dihedral angle at the edge shared by faces k and l.
+    for (int k = 0; k < 4; ++k)
+      for (int l = k + 1; l < 4; ++l) {
+        const double angle = 180.0 - std::acos(std::clamp(n[k].dot(n[l]), -1.0, 1.0)) * 180.0 / M_PI;
+        q.min_dihedral = std::min(q.min_dihedral, angle);
+        q.max_dihedral = std::max(q.max_dihedral, angle);
+      }
+  }
+  if (mesh.tets.empty()) q.min_dihedral = 0;
+  return q;
+}
+
+void write_vtu(std::ostream& out, const TetMesh& mesh) {
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<UnstructuredGrid>\n"
+      << "<Piece NumberOfPoints=\"" << mesh.points.size() << "\" NumberOfCells=\"" << mesh.tets.size() << "\">\n"
+      << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& p : mesh.points) out << number(p[0]) << ' ' << number(p[1]) << ' ' << number(p[2]) << '\n';
+  out << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const auto& t : mesh.tets) out << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (size_t i = 0; i < mesh.tets.size(); ++i) out << 4 * (i + 1) << '\n';
+  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (size_t i = 0; i < mesh.tets.size(); ++i) out << "10\n";  // VTK_TETRA
+  out << "</DataArray>\n</Cells>\n<CellData Scalars=\"region\">\n"
+      << "<DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">\n";
+  for (int r : mesh.tet_region) out << r << '\n';
+  out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+}
+
+void write_gmsh(std::ostream& out, const TetMesh& mesh) {
+  // One surface entity per face marker and one volume entity per region, each
+  // its own physical group with the same tag.
+  const std::set<int> markers(mesh.face_marker.begin(), mesh.face_marker.end());
+  const std::set<int> regions(mesh.tet_region.begin(), mesh.tet_region.end());
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (const auto& p : mesh.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  auto names = [](int dim, int tag) -> std::string {
+    if (dim == 2) return tag == kFaceSkin ? "skin" : tag == kFaceCavity ? "cavity_surface" : tag == kFaceBox ? "box" : "faces";
+    return tag == kRegionInterior ? "interior" : tag == kRegionSolvent ? "solvent" : tag == kRegionCavity ? "cavity" : "region";
+  };
+  const std::string box = number(lo[0]) + ' ' + number(lo[1]) + ' ' + number(lo[2]) + ' ' + number(hi[0]) + ' ' +
+                          number(hi[1]) + ' ' + number(hi[2]);
+  out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
+  out << "$PhysicalNames\n" << markers.size() + regions.size() << '\n';
+  for (int m : markers) out << "2 " << m << " \"" << names(2, m) << "\"\n";
+  for (int r : regions) out << "3 " << r << " \"" << names(3, r) << "\"\n";
+  out << "$EndPhysicalNames\n";
+  out << "$Entities\n0 0 " << markers.size() << ' ' << regions.size() << '\n';
+  for (int m : markers) out << m << ' ' << box << " 1 " << m << " 0\n";
+  for (int r : regions) out << r << ' ' << box << " 1 " << r << " 0\n";
+  out << "$EndEntities\n";
+  // All nodes in one block, classified on the first volume.
+  const int node_entity = regions.empty() ? 1 : *regions.begin();
+  out << "$Nodes\n1 " << mesh.points.size() << " 1 " << mesh.points.size() << '\n';
+  out << "3 " << node_entity << " 0 " << mesh.points.size() << '\n';
+  for (size_t i = 0; i < mesh.points.size(); ++i) out << i + 1 << '\n';
+  for (const auto& p : mesh.points) out << number(p[0]) << ' ' << number(p[1]) << ' ' << number(p[2]) << '\n';
+  out << "$EndNodes\n";
+  std::map<int, std::vector<size_t>> faces_of, tets_of;
+  for (size_t i = 0; i < mesh.faces.size(); ++i) faces_of[mesh.face_marker[i]].push_back(i);
+  for (size_t i = 0; i < mesh.tets.size(); ++i) tets_of[mesh.tet_region[i]].push_back(i);
+  const size_t total = mesh.faces.size() + mesh.tets.size();
+  out << "$Elements\n" << faces_of.size() + tets_of.size() << ' ' << total << " 1 " << total << '\n';
+  size_t tag = 1;
+  for (const auto& [m, list] : faces_of) {
+    out << "2 " << m << " 2 " << list.size() << '\n';  // 3-node triangles
+    for (size_t i : list) {
+      const auto& f = mesh.faces[i];
+      out << tag++ << ' ' << f[0] + 1 << ' ' << f[1] + 1 << ' ' << f[2] + 1 << '\n';
+    }
+  }
+  for (const auto& [r, list] : tets_of) {
+    out << "3 " << r << " 4 " << list.size() << '\n';  // 4-node tetrahedra
+    for (size_t i : list) {
+      const auto& t = mesh.tets[i];
+      out << tag++ << ' ' << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << ' ' << t[3] + 1 << '\n';
+    }
+  }
+  out << "$EndElements\n";
+}
+
+void write_tetgen_node(std::ostream& out, const TetMesh& mesh) {
+  out << mesh.points.size() << " 3 0 0\n";
+  for (size_t i = 0; i < mesh.points.size(); ++i)
+    out << i << ' ' << number(mesh.points[i][0]) << ' ' << number(mesh.points[i][1]) << ' '
+        << number(mesh.points[i][2]) << '\n';
+}
+
+void write_tetgen_ele(std::ostream& out, const TetMesh& mesh) {
+  out << mesh.tets.size() << " 4 1\n";
+  for (size_t i = 0; i < mesh.tets.size(); ++i) {
+    const auto& t = mesh.tets[i];
+    out << i << ' ' << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << ' ' << mesh.tet_region[i] << '\n';
+  }
+}
+
+void write_tetgen_face(std::ostream& out, const TetMesh& mesh) {
+  out << mesh.faces.size() << " 1\n";
+  for (size_t i = 0; i < mesh.faces.size(); ++i) {
+    const auto& f = mesh.faces[i];
+    out << i << ' ' << f[0] << ' ' << f[1] << ' ' << f[2] << ' ' << mesh.face_marker[i] << '\n';
+  }
+}
+
+}  // namespace skinmesh
