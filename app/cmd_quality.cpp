@@ -7,6 +7,7 @@
 
 #include "skinmesh/meshing/mesh_io.hpp"
 #include "skinmesh/meshing/mesh_quality.hpp"
+#include "skinmesh/meshing/volume_mesh.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -23,6 +24,7 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
     std::string mesh;
     std::string svg;
     bool no_self_intersections = false;
+    bool tetgen = false;
     MoleculeOptions molecule;
   };
   auto o = std::make_shared<Options>();
@@ -31,6 +33,7 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
   cmd->add_option("--molecule", o->molecule.path, "also measure each vertex's distance to this molecule's skin");
   cmd->add_option("--svg", o->svg, "write a histogram of the smallest angles as SVG");
   cmd->add_flag("--no-self-intersections", o->no_self_intersections, "skip the exact self-intersection check");
+  cmd->add_flag("--tetgen", o->tetgen, "also count self-intersections with TetGen's -d check (a second opinion)");
   add_molecule_settings(*cmd, o->molecule);
   cmd->callback([o, &global, &exit_code]() {
     const SurfaceMesh mesh = read_surface_mesh(o->mesh);
@@ -39,6 +42,7 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
     const MeshQuality q = grade_mesh(mesh, grade);
     json report = to_json(q);
     report["file"] = o->mesh;
+    if (o->tetgen) report["tetgen_self_intersecting_pairs"] = tetgen_self_intersections(mesh);
     if (!o->molecule.path.empty()) {
       const Molecule m = read_molecule(o->molecule.path, o->molecule.read);
       const auto balls = balls_from_molecule(m, o->molecule.shrink, o->molecule.convention());
@@ -53,6 +57,9 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
       std::cout << report.dump(2) << "\n";
     } else {
       print_quality_summary(std::cout, o->mesh, q);
+      if (report.contains("tetgen_self_intersecting_pairs"))
+        std::cout << "  TetGen -d:   " << report["tetgen_self_intersecting_pairs"].get<long>()
+                  << " intersecting pairs\n";
       if (report.contains("on_surface_error"))
         std::cout << "  on-surface error: max " << report["on_surface_error"]["max"].get<double>() << " A, mean "
                   << report["on_surface_error"]["mean"].get<double>() << " A (oracle, " << o->molecule.path << ")\n";

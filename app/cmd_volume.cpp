@@ -92,6 +92,7 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
       return;
     }
     const TetQuality q = grade_tet_mesh(tets);
+    const long tetgen_pairs = tetgen_self_intersections(surface.mesh, volume.tetgen);
     // The interior's tetrahedra fill exactly what the skin encloses (its
     // outer components minus kept cavities).
     double enclosed = 0;
@@ -110,6 +111,7 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
         {"molecule", o->molecule.path},
         {"domain", o->domain},
         {"surface", to_json(sq)},
+        {"surface_self_intersections", {{"cgal_exact", sq.self_intersecting_pairs}, {"tetgen", tetgen_pairs}}},
         {"tetrahedra", q.tets},
         {"points", q.points},
         {"min_dihedral_deg", q.min_dihedral},
@@ -142,7 +144,8 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
         std::cout << "  region " << name << ": " << r["tetrahedra"].get<long>() << " tetrahedra, volume "
                   << r["volume"].get<double>() << " A^3\n";
       std::cout << "  skin: " << sq.triangles << " triangles, closed oriented manifold, "
-                << sq.self_intersecting_pairs << " self-intersections, encloses " << enclosed << " A^3\n";
+                << sq.self_intersecting_pairs << " self-intersecting pairs (CGAL, exact), " << tetgen_pairs
+                << " (TetGen -d); encloses " << enclosed << " A^3\n";
     }
     exit_code = 0;
   });

@@ -174,3 +174,21 @@ TEST_CASE("volume mesh files read back; open surfaces are refused", "[volume]") 
   open.triangles.pop_back();
   CHECK_THROWS_AS(tetrahedralize(open), VolumeMeshError);
 }
+
+TEST_CASE("self-intersections: CGAL's exact check and TetGen's agree", "[volume][intersections]") {
+  // Two unit tetrahedra, the second shifted into the first.
+  SurfaceMesh two;
+  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.2, 0.2)}) {
+    const int base = static_cast<int>(two.vertices.size());
+    for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                     Eigen::Vector3d(0, 0, 1)})
+      two.vertices.push_back(p + shift);
+    for (const std::array<int, 3>& t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}})
+      two.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+  }
+  CHECK(count_self_intersections(two) > 0);
+  CHECK(tetgen_self_intersections(two) > 0);
+  const SurfaceMesh skin = skin_mesh(test::data_file("pept.pdb"));
+  CHECK(count_self_intersections(skin) == 0);
+  CHECK(tetgen_self_intersections(skin) == 0);
+}

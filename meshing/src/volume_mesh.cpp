@@ -108,6 +108,30 @@ std::string format_number(double v) {
   return buffer;
 }
 
+struct Marked {
+  Eigen::Vector3d point;
+  int region;
+};
+
+// A TetGen .smesh: points, triangles with markers, hole points, region points.
+void write_smesh(std::ostream& out, const std::vector<Eigen::Vector3d>& points,
+                 const std::vector<std::array<int, 3>>& facets, const std::vector<int>& markers,
+                 const std::vector<Eigen::Vector3d>& holes, const std::vector<Marked>& regions) {
+  auto xyz = [](const Eigen::Vector3d& p) {
+    return format_number(p[0]) + ' ' + format_number(p[1]) + ' ' + format_number(p[2]);
+  };
+  out << points.size() << " 3 0 0\n";
+  for (size_t i = 0; i < points.size(); ++i) out << i << ' ' << xyz(points[i]) << '\n';
+  out << facets.size() << " 1\n";
+  for (size_t f = 0; f < facets.size(); ++f)
+    out << "3 " << facets[f][0] << ' ' << facets[f][1] << ' ' << facets[f][2] << ' ' << markers[f] << '\n';
+  out << holes.size() << '\n';
+  for (size_t h = 0; h < holes.size(); ++h) out << h << ' ' << xyz(holes[h]) << '\n';
+  out << regions.size() << '\n';
+  for (size_t r = 0; r < regions.size(); ++r)
+    out << r << ' ' << xyz(regions[r].point) << ' ' << regions[r].region << " -1\n";
+}
+
 // Reads the next line that is not empty or a comment.
 bool next_line(std::istream& in, std::istringstream& line) {
   std::string text;
@@ -187,10 +211,6 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const VolumeOptions& optio
   }
   component = kept_component;
 
-  struct Marked {
-    Eigen::Vector3d point;
-    int region;
-  };
   std::vector<Eigen::Vector3d> holes;
   std::vector<Marked> regions;
   std::vector<bool> seen(static_cast<size_t>(count), false);
@@ -282,21 +302,7 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const VolumeOptions& optio
   const std::string stem = dir.path + "/plc";
   {
     std::ofstream out(stem + ".smesh");
-    out << points.size() << " 3 0 0\n";
-    for (size_t i = 0; i < points.size(); ++i)
-      out << i << ' ' << format_number(points[i][0]) << ' ' << format_number(points[i][1]) << ' '
-          << format_number(points[i][2]) << '\n';
-    out << facets.size() << " 1\n";
-    for (size_t f = 0; f < facets.size(); ++f)
-      out << "3 " << facets[f][0] << ' ' << facets[f][1] << ' ' << facets[f][2] << ' ' << markers[f] << '\n';
-    out << holes.size() << '\n';
-    for (size_t h = 0; h < holes.size(); ++h)
-      out << h << ' ' << format_number(holes[h][0]) << ' ' << format_number(holes[h][1]) << ' '
-          << format_number(holes[h][2]) << '\n';
-    out << regions.size() << '\n';
-    for (size_t r = 0; r < regions.size(); ++r)
-      out << r << ' ' << format_number(regions[r].point[0]) << ' ' << format_number(regions[r].point[1]) << ' '
-          << format_number(regions[r].point[2]) << ' ' << regions[r].region << " -1\n";
+    write_smesh(out, points, facets, markers, holes, regions);
     if (!out) throw VolumeMeshError("cannot write TetGen's input in " + dir.path);
   }
   // -p: a piecewise linear complex; -z: zero-based; -A: region attributes;
@@ -372,6 +378,29 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const VolumeOptions& optio
       std::swap(t[2], t[3]);
   }
   return mesh;
+}
+
+long tetgen_self_intersections(const SurfaceMesh& surface, const std::string& tetgen) {
+  TempDir dir;
+  const std::string stem = dir.path + "/plc";
+  {
+    std::ofstream out(stem + ".smesh");
+    write_smesh(out, surface.vertices, surface.triangles, std::vector<int>(surface.triangles.size(), kFaceSkin), {},
+                {});
+    if (!out) throw VolumeMeshError("cannot write TetGen's input in " + dir.path);
+  }
+  const std::string command = tetgen + " -dz '" + stem + ".smesh' > '" + stem + ".log' 2>&1";
+  if (std::system(command.c_str()) != 0)
+    throw VolumeMeshError("TetGen failed (" + command + "): " + read_tail(stem + ".log"));
+  // TetGen says "!! Found N pairs of faces are intersecting." when it finds any.
+  std::ifstream log(stem + ".log");
+  std::string text;
+  while (std::getline(log, text)) {
+    const size_t at = text.find("Found ");
+    if (at != std::string::npos && text.find("intersecting") != std::string::npos)
+      return std::atol(text.c_str() + at + 6);
+  }
+  return 0;
 }
 
 }  // namespace skinmesh

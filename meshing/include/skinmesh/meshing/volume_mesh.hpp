@@ -55,6 +55,10 @@ class VolumeMeshError : public std::runtime_error {
 // writes it); components with negative enclosed volume are cavities.
 TetMesh tetrahedralize(const SurfaceMesh& surface, const VolumeOptions& options = {});
 
+// A second opinion on self-intersections, independent of CGAL: TetGen's -d
+// check of the surface. Returns the number of intersecting triangle pairs.
+long tetgen_self_intersections(const SurfaceMesh& surface, const std::string& tetgen = "tetgen");
+
 // Quality of a tetrahedral mesh.
 struct TetQuality {
   long points = 0, tets = 0;
