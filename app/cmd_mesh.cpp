@@ -60,7 +60,7 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("mesh", "quality triangle mesh of the molecular skin");
   add_molecule_options(*cmd, o->molecule);
-  cmd->add_option("--output,-o", o->output, "mesh file: .ply .off .obj .stl .vtp, or .vert (MSMS .vert + .face)")
+  cmd->add_option("--output,-o", o->output, "mesh file: .ply .off .obj .stl .vtp .msh (Gmsh), or .vert (MSMS .vert + .face)")
       ->required();
   cmd->add_option("--report", o->report, "write the quality report as JSON");
   cmd->add_option("--svg", o->svg, "write a histogram of the smallest angles as SVG");

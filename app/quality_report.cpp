@@ -27,6 +27,7 @@ nlohmann::json to_json(const MeshQuality& q) {
           {"area", q.area},
           {"volume", q.volume},
           {"components", q.components},
+          {"cavities", q.cavities},
           {"euler_characteristic", q.euler},
           {"genus", q.genus >= 0 ? json(q.genus) : json(nullptr)},
           {"closed", q.closed},
@@ -83,7 +84,8 @@ void print_quality_summary(std::ostream& out, const std::string& name, const Mes
       << "  ratios:      radius-edge max " << q.max_radius_edge << ", aspect max " << q.max_aspect << "\n"
       << "  edges:       " << q.min_edge << " / " << q.mean_edge << " / " << q.max_edge << " A (min/mean/max)\n"
       << "  size:        area " << q.area << " A^2, volume " << q.volume << " A^3\n"
-      << "  topology:    " << q.components << " component(s), Euler characteristic " << q.euler << ", genus "
+      << "  topology:    " << q.components << " component(s) (" << q.cavities << " cavities), Euler characteristic "
+      << q.euler << ", genus "
       << (q.genus >= 0 ? std::to_string(q.genus) : std::string("n/a")) << "\n"
       << "  defects:     " << q.boundary_edges << " boundary edges, " << q.nonmanifold_edges
       << " non-manifold edges, " << q.nonmanifold_vertices << " non-manifold vertices, " << q.inconsistent_edges

@@ -32,7 +32,7 @@ TEST_CASE("written meshes read back with the same vertices and triangles", "[io]
   VertexAttributes attributes;
   attributes.patch = {0, 1, 2, 3, 0, 1};
   attributes.atom = {5, 4, 3, 2, 1, 0};
-  for (const char* name : {"m.ply", "m.off", "m.obj", "m.stl"}) {
+  for (const char* name : {"m.ply", "m.off", "m.obj", "m.stl", "m.msh"}) {
     INFO(name);
     TempFile file(name);
     {

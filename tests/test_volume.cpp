@@ -25,8 +25,8 @@ SurfaceMesh skin_mesh(const std::string& path) {
   return mesh_skin(build_skin_complex(balls, {0.5})).mesh;
 }
 
-double enclosed_volume(const SurfaceMesh& m, bool outer_only = false) {
-  // Per component when outer_only: cavities (negative) are left out.
+// Enclosed volume per connected component (union-find over vertices).
+std::map<int, double> component_volumes(const SurfaceMesh& m) {
   std::vector<int> parent(m.vertices.size());
   for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
   std::function<int(int)> find = [&](int x) { return parent[x] == x ? x : parent[x] = find(parent[x]); };
@@ -34,6 +34,12 @@ double enclosed_volume(const SurfaceMesh& m, bool outer_only = false) {
   std::map<int, double> per;
   for (const auto& t : m.triangles)
     per[find(t[0])] += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6.0;
+  return per;
+}
+
+double enclosed_volume(const SurfaceMesh& m, bool outer_only = false) {
+  // Per component when outer_only: cavities (negative) are left out.
+  const std::map<int, double> per = component_volumes(m);
   double v = 0;
   for (const auto& [c, w] : per)
     if (!outer_only || w > 0) v += w;
@@ -89,7 +95,11 @@ TEST_CASE("solvent and cavity regions get their markers", "[volume]") {
   // pept's skin has a cavity: a component with negative enclosed volume.
   const SurfaceMesh surface = skin_mesh(test::data_file("pept.pdb"));
   const double outer = enclosed_volume(surface, true), net = enclosed_volume(surface);
-  REQUIRE(outer - net > 1.0);  // the cavity holds more than 1 A^3
+  REQUIRE(outer - net > 1.0);  // the cavities hold more than 1 A^3
+  long negative = 0;
+  for (const auto& [c, v] : component_volumes(surface)) negative += v < 0;
+  CHECK(grade_mesh(surface, GradeOptions{false}).cavities == negative);
+  CHECK(negative >= 1);
   VolumeOptions both;
   both.domain = VolumeDomain::both;
   both.box_margin = 5.0;

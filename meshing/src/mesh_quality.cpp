@@ -147,7 +147,16 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
   q.closed = q.boundary_edges == 0;
   q.manifold = q.nonmanifold_edges == 0 && q.nonmanifold_vertices == 0;
   q.oriented = q.inconsistent_edges == 0;
-  if (q.closed && q.manifold && q.oriented) q.genus = (2 * q.components - q.euler) / 2;
+  if (q.closed && q.manifold && q.oriented) {
+    q.genus = (2 * q.components - q.euler) / 2;
+    // A closed component that encloses negative volume faces inward: with
+    // outward normals everywhere else, it is the surface of a cavity.
+    std::unordered_map<int, double> enclosed;
+    for (const auto& t : T)
+      enclosed[uf.find(t[0])] += V[static_cast<size_t>(t[0])].dot(
+                                     V[static_cast<size_t>(t[1])].cross(V[static_cast<size_t>(t[2])])) / 6.0;
+    for (const auto& [root, volume] : enclosed) q.cavities += volume < 0;
+  }
 
   if (options.check_self_intersections && q.manifold && q.oriented && q.degenerate_triangles == 0) {
     const long pairs = count_self_intersections(mesh);

@@ -331,6 +331,73 @@ SurfaceMesh read_msms(const std::string& path) {
   return mesh;
 }
 
+// Gmsh MSH 4.x ASCII: the nodes of every entity block, and the triangles
+// (type 2) and quadrangles (type 3) of the element blocks; other element
+// types (lines, points, volumes) are skipped.
+SurfaceMesh read_gmsh(const std::string& path) {
+  const std::string text = read_all(path);
+  Tokens t = tokenize(text, path);
+  auto seek = [&](const char* section) {
+    while (!t.done() && t.words[t.next] != section) ++t.next;
+    if (t.done()) input_error(path, 0, std::string("no ") + section + " section");
+    ++t.next;
+  };
+  seek("$MeshFormat");
+  const long at = t.line();
+  const std::string version = t.word();
+  if (version.rfind("4", 0) != 0) input_error(path, at, "Gmsh format " + version + " (only 4.x is read)");
+  if (t.integer() != 0) input_error(path, at, "binary Gmsh files are not read (save as ASCII)");
+  t.next = 0;
+  seek("$Nodes");
+  SurfaceMesh mesh;
+  std::map<long, int> index;
+  const long node_blocks = t.integer();
+  t.integer();  // number of nodes
+  t.integer();  // smallest tag
+  t.integer();  // largest tag
+  for (long b = 0; b < node_blocks; ++b) {
+    t.integer();  // entity dimension
+    t.integer();  // entity tag
+    const long parametric = t.integer(), count = t.integer();
+    std::vector<long> tags;
+    for (long i = 0; i < count; ++i) tags.push_back(t.integer());
+    for (long i = 0; i < count; ++i) {
+      const long line = t.line();
+      const double x = t.number(), y = t.number(), z = t.number();
+      if (parametric) while (!t.done() && t.lines[t.next] == line) t.word();
+      index[tags[static_cast<size_t>(i)]] = static_cast<int>(mesh.vertices.size());
+      mesh.vertices.push_back(checked_point(x, y, z, path, line));
+    }
+  }
+  seek("$Elements");
+  const long element_blocks = t.integer();
+  t.integer();
+  t.integer();
+  t.integer();
+  for (long b = 0; b < element_blocks; ++b) {
+    t.integer();  // entity dimension
+    t.integer();  // entity tag
+    const long block_line = t.line();
+    const long type = t.integer(), count = t.integer();
+    const std::map<long, int> corners_of{{15, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 4}, {5, 8}, {6, 6}, {7, 5}};
+    const auto known = corners_of.find(type);
+    if (known == corners_of.end()) input_error(path, block_line, "unsupported Gmsh element type " + std::to_string(type));
+    for (long e = 0; e < count; ++e) {
+      const long line = t.line();
+      t.integer();  // element tag
+      std::vector<long> corners;
+      for (int k = 0; k < known->second; ++k) {
+        const long tag = t.integer();
+        const auto it = index.find(tag);
+        if (it == index.end()) input_error(path, line, "element refers to node " + std::to_string(tag) + ", not in $Nodes");
+        corners.push_back(it->second);
+      }
+      if (type == 2 || type == 3) add_polygon(mesh, corners, path, line);
+    }
+  }
+  return mesh;
+}
+
 }  // namespace
 
 SurfaceMesh read_surface_mesh(const std::string& path) {
@@ -340,7 +407,8 @@ SurfaceMesh read_surface_mesh(const std::string& path) {
   else if (has_extension(path, ".stl")) mesh = read_stl(path);
   else if (has_extension(path, ".ply")) mesh = read_ply(path);
   else if (has_extension(path, ".vert") || has_extension(path, ".face")) mesh = read_msms(path);
-  else input_error(path, 0, "unknown mesh format (expected .off, .obj, .stl, .ply, or an MSMS .vert/.face pair)");
+  else if (has_extension(path, ".msh")) mesh = read_gmsh(path);
+  else input_error(path, 0, "unknown mesh format (expected .off, .obj, .stl, .ply, .msh, or an MSMS .vert/.face pair)");
   if (mesh.triangles.empty()) input_error(path, 0, "mesh has no triangles");
   return mesh;
 }

@@ -141,6 +141,27 @@ void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
 
 }  // namespace
 
+// Gmsh MSH 4.1 ASCII: one surface entity, physical group 1 named "skin".
+void write_gmsh_surface(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (const auto& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  if (mesh.vertices.empty()) lo = hi = Eigen::Vector3d::Zero();
+  out << std::setprecision(digits(options));
+  out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"skin\"\n$EndPhysicalNames\n";
+  out << "$Entities\n0 0 1 0\n1 " << lo[0] << ' ' << lo[1] << ' ' << lo[2] << ' ' << hi[0] << ' ' << hi[1] << ' '
+      << hi[2] << " 1 1 0\n$EndEntities\n";
+  const size_t n = mesh.vertices.size(), m = mesh.triangles.size();
+  out << "$Nodes\n1 " << n << " 1 " << n << "\n2 1 0 " << n << "\n";
+  for (size_t i = 0; i < n; ++i) out << i + 1 << "\n";
+  for (const auto& v : mesh.vertices) out << v[0] << ' ' << v[1] << ' ' << v[2] << "\n";
+  out << "$EndNodes\n$Elements\n1 " << m << " 1 " << m << "\n2 1 2 " << m << "\n";
+  for (size_t i = 0; i < m; ++i) {
+    const auto& t = mesh.triangles[i];
+    out << i + 1 << ' ' << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << "\n";
+  }
+  out << "$EndElements\n";
+}
+
 MeshFormat mesh_format_from_path(const std::string& path) {
   if (has_extension(path, ".ply")) return MeshFormat::ply;
   if (has_extension(path, ".off")) return MeshFormat::off;
@@ -148,7 +169,8 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (has_extension(path, ".stl")) return MeshFormat::stl;
   if (has_extension(path, ".vtp")) return MeshFormat::vtp;
   if (has_extension(path, ".vert")) return MeshFormat::msms;
-  throw std::invalid_argument(path + ": unknown mesh format (use .ply, .off, .obj, .stl, .vtp or .vert for MSMS)");
+  if (has_extension(path, ".msh")) return MeshFormat::gmsh;
+  throw std::invalid_argument(path + ": unknown mesh format (use .ply, .off, .obj, .stl, .vtp, .msh, or .vert for MSMS)");
 }
 
 const char* mesh_format_name(MeshFormat format) {
@@ -159,6 +181,7 @@ const char* mesh_format_name(MeshFormat format) {
     case MeshFormat::stl: return "stl";
     case MeshFormat::vtp: return "vtp";
     case MeshFormat::msms: return "msms";
+    case MeshFormat::gmsh: return "gmsh";
   }
   return "?";
 }
@@ -168,6 +191,7 @@ void write_mesh(std::ostream& out, const SurfaceMesh& mesh, MeshFormat format, c
   switch (format) {
     case MeshFormat::ply: write_ply(out, mesh, attributes, options); break;
     case MeshFormat::off: write_off(out, mesh, options); break;
+    case MeshFormat::gmsh: write_gmsh_surface(out, mesh, options); break;
     case MeshFormat::obj: write_obj(out, mesh, options); break;
     case MeshFormat::stl: write_stl(out, mesh); break;
     case MeshFormat::vtp: write_vtp(out, mesh, attributes, options); break;

@@ -1,6 +1,7 @@
 // Reading surface meshes from other tools as polygon soups (so that a broken
 // mesh can be graded, not rejected): OFF, OBJ, STL (ASCII and binary), PLY
-// (ASCII and binary little/big endian), and MSMS .vert/.face pairs.
+// (ASCII and binary little/big endian), Gmsh 4.x ASCII (.msh), and MSMS
+// .vert/.face pairs.
 #pragma once
 
 #include "skinmesh/core/surface_mesh.hpp"
@@ -9,7 +10,7 @@
 
 namespace skinmesh {
 
-// Chooses the format from the extension (.off .obj .stl .ply .vert .face; for
+// Chooses the format from the extension (.off .obj .stl .ply .msh .vert .face; for
 // MSMS either file of the pair). Polygons with more than three corners are fanned
 // into triangles. STL corners are merged when their coordinates are identical.
 // Throws InputError naming the file and line.

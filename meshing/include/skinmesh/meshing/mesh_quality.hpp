@@ -29,6 +29,7 @@ struct MeshQuality {
   double area = 0;                           // Angstrom^2
   double volume = 0;                         // Angstrom^3, signed (positive for outward triangles)
   long components = 0;
+  long cavities = 0;                         // components enclosing negative volume (inner surfaces of voids)
   long euler = 0;                            // V - E + F (vertices used by triangles)
   long genus = -1;                           // total genus; -1 unless closed, manifold, oriented
   long boundary_edges = 0, nonmanifold_edges = 0, nonmanifold_vertices = 0;

@@ -11,7 +11,7 @@
 
 namespace skinmesh {
 
-enum class MeshFormat { ply, off, obj, stl, vtp, msms };
+enum class MeshFormat { ply, off, obj, stl, vtp, msms, gmsh };
 
 // From the file name: .ply .off .obj .stl .vtp .vert (MSMS: .vert and .face).
 // Throws std::invalid_argument for anything else.
