@@ -141,7 +141,7 @@ TEST_CASE("skinmesh quality grades CGAL's skin mesh and ours side by side", "[cl
   CHECK(c["on_surface_error"]["max"].get<double>() > 1e-9);
 }
 
-TEST_CASE("skinmesh mesh writes a mesh, a report and MSMS files; failures leave nothing behind", "[cli][mesh]") {
+TEST_CASE("skinmesh mesh writes a mesh, a report and MSMS files, and failures leave nothing behind", "[cli][mesh]") {
   skinmesh::test::TempFile out("pept.ply");
   const std::string report = out.path() + ".json";
   const Run r = run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + out.path() + " --report " + report +

@@ -135,7 +135,7 @@ TEST_CASE("solvent and cavity regions get their markers", "[volume]") {
   CHECK(std::abs(region_volume(full, kRegionInterior) - outer) <= 1e-9 * outer);
 }
 
-TEST_CASE("volume mesh files read back; open surfaces are refused", "[volume]") {
+TEST_CASE("volume mesh files read back, and open surfaces are refused", "[volume]") {
   const SurfaceMesh surface = skin_mesh(test::data_file("pept.pdb"));
   VolumeOptions both;
   both.domain = VolumeDomain::both;

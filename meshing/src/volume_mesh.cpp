@@ -313,7 +313,7 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const VolumeOptions& optio
   // 1.6, got 1.64 inside and 2.02 with the solvent), and the result is graded.
   std::ostringstream switches;
   switches << "-pzAYQ -q" << kTetgenTightening * options.max_radius_edge << '/'
-           << std::min(options.min_dihedral + 2.0, 18.0);
+           << std::min(options.min_dihedral + 5.0, 18.0);
   if (options.max_volume > 0) switches << " -a" << options.max_volume;
   const std::string command =
       options.tetgen + ' ' + switches.str() + " '" + stem + ".smesh' > '" + stem + ".log' 2>&1";
