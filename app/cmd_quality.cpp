@@ -28,7 +28,7 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
     MoleculeOptions molecule;
   };
   auto o = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("quality", "grade a triangle mesh (OFF, PLY, OBJ, STL, MSMS .vert/.face)");
+  CLI::App* cmd = app.add_subcommand("quality", "grade a triangle mesh (OFF, PLY, OBJ, STL, Gmsh, MSMS .vert/.face) or a tetrahedral one (TetGen .node/.ele, Gmsh)");
   cmd->add_option("mesh", o->mesh, "mesh file")->required();
   cmd->add_option("--molecule", o->molecule.path, "also measure each vertex's distance to this molecule's skin");
   cmd->add_option("--svg", o->svg, "write a histogram of the smallest angles as SVG");
@@ -36,6 +36,34 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
   cmd->add_flag("--tetgen", o->tetgen, "also count self-intersections with TetGen's -d check (a second opinion)");
   add_molecule_settings(*cmd, o->molecule);
   cmd->callback([o, &global, &exit_code]() {
+    // Tetrahedral meshes (TetGen's files, or a Gmsh file with tetrahedra).
+    const bool tetgen_files = [&] {
+      for (const char* ext : {".node", ".ele"})
+        if (o->mesh.size() > 5 && o->mesh.compare(o->mesh.size() - std::string(ext).size(), std::string::npos, ext) == 0)
+          return true;
+      return false;
+    }();
+    if (tetgen_files || gmsh_has_tetrahedra(o->mesh)) {
+      const TetMesh tets = read_tet_mesh(o->mesh);
+      const TetQuality q = grade_tet_mesh(tets);
+      json report = tet_report(tets, q);
+      report["file"] = o->mesh;
+      if (global.json) {
+        std::cout << report.dump(2) << "\n";
+      } else {
+        std::cout << o->mesh << ": " << q.points << " points, " << q.tets << " tetrahedra, volume " << q.volume
+                  << " A^3\n";
+        print_tet_quality(std::cout, q);
+        for (const auto& [r, v] : report["regions"].items())
+          std::cout << "  region " << r << ": " << v["tetrahedra"].get<long>() << " tetrahedra, volume "
+                    << v["volume"].get<double>() << " A^3\n";
+        std::cout << "  boundary:        " << report["boundary_faces"].get<long>() << " faces; "
+                  << report["boundary_faces_not_marked"].get<long>() << " not among the marked faces, "
+                  << report["marked_faces_not_on_boundary"].get<long>() << " marked faces not on a boundary\n";
+      }
+      exit_code = 0;
+      return;
+    }
     const SurfaceMesh mesh = read_surface_mesh(o->mesh);
     GradeOptions grade;
     grade.check_self_intersections = !o->no_self_intersections;

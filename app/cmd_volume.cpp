@@ -118,6 +118,7 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
         {"max_dihedral_deg", q.max_dihedral},
         {"max_radius_edge_ratio", q.max_radius_edge},
         {"max_radius_edge_ratio_off_boundary", q.max_radius_edge_off_boundary},
+        {"min_dihedral_deg_off_boundary", q.min_dihedral_off_boundary},
         {"inverted", q.inverted},
         {"regions", regions},
         {"enclosed_volume", enclosed},
@@ -136,10 +137,8 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
       std::cout << report.dump(2) << "\n";
     } else if (!global.quiet) {
       std::cout << o->output << ".{vtu,msh,node,ele,face}: " << q.tets << " tetrahedra, " << q.points << " points ("
-                << o->domain << ")\n"
-                << "  dihedral angles: " << q.min_dihedral << " - " << q.max_dihedral << " deg; radius-edge max "
-                << q.max_radius_edge << " (" << q.max_radius_edge_off_boundary << " away from the surface); "
-                << q.inverted << " inverted\n";
+                << o->domain << ")\n";
+      print_tet_quality(std::cout, q);
       for (const auto& [name, r] : regions.items())
         std::cout << "  region " << name << ": " << r["tetrahedra"].get<long>() << " tetrahedra, volume "
                   << r["volume"].get<double>() << " A^3\n";

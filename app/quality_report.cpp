@@ -1,6 +1,8 @@
 #include "quality_report.hpp"
 
 #include <algorithm>
+#include <map>
+#include <set>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -94,6 +96,59 @@ void print_quality_summary(std::ostream& out, const std::string& name, const Mes
       << (q.self_intersections_checked ? std::to_string(q.self_intersecting_pairs) + " pairs"
                                        : std::string("not checked (needs a manifold, oriented mesh)"))
       << "\n";
+}
+
+nlohmann::json tet_report(const TetMesh& mesh, const TetQuality& q) {
+  // The faces a solver sees as boundaries: faces of exactly one tetrahedron,
+  // and faces between tetrahedra of different regions. They should be the
+  // mesh's marked faces, no more and no fewer.
+  std::map<std::array<int, 3>, std::vector<int>> owners;
+  for (size_t i = 0; i < mesh.tets.size(); ++i) {
+    const auto& t = mesh.tets[i];
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<int, 3> f{};
+      int k = 0;
+      for (int j = 0; j < 4; ++j)
+        if (j != skip) f[static_cast<size_t>(k++)] = t[static_cast<size_t>(j)];
+      std::sort(f.begin(), f.end());
+      owners[f].push_back(mesh.tet_region[i]);
+    }
+  }
+  std::set<std::array<int, 3>> boundary, marked;
+  for (const auto& [f, regions] : owners)
+    if (regions.size() == 1 || regions[0] != regions[1]) boundary.insert(f);
+  for (auto f : mesh.faces) {
+    std::sort(f.begin(), f.end());
+    marked.insert(f);
+  }
+  long unmarked = 0, stray = 0;
+  for (const auto& f : boundary) unmarked += !marked.count(f);
+  for (const auto& f : marked) stray += !boundary.count(f);
+  std::map<int, long> counts;
+  for (int r : mesh.tet_region) ++counts[r];
+  nlohmann::json regions = nlohmann::json::object();
+  for (const auto& [r, n] : counts)
+    regions[std::to_string(r)] = {{"tetrahedra", n}, {"volume", region_volume(mesh, r)}};
+  return {{"points", q.points},
+          {"tetrahedra", q.tets},
+          {"volume", q.volume},
+          {"min_dihedral_deg", q.min_dihedral},
+          {"max_dihedral_deg", q.max_dihedral},
+          {"max_radius_edge_ratio", q.max_radius_edge},
+          {"max_radius_edge_ratio_off_boundary", q.max_radius_edge_off_boundary},
+          {"min_dihedral_deg_off_boundary", q.min_dihedral_off_boundary},
+          {"inverted", q.inverted},
+          {"regions", regions},
+          {"boundary_faces", static_cast<long>(boundary.size())},
+          {"boundary_faces_not_marked", unmarked},
+          {"marked_faces_not_on_boundary", stray}};
+}
+
+void print_tet_quality(std::ostream& out, const TetQuality& q) {
+  out << "  dihedral angles: " << q.min_dihedral << " - " << q.max_dihedral << " deg ("
+      << q.min_dihedral_off_boundary << " min away from the surface)\n"
+      << "  radius-edge:     max " << q.max_radius_edge << " (" << q.max_radius_edge_off_boundary
+      << " away from the surface); " << q.inverted << " inverted\n";
 }
 
 }  // namespace skinmesh::app

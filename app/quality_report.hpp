@@ -5,6 +5,7 @@
 
 #include "skinmesh/core/balls.hpp"
 #include "skinmesh/meshing/mesh_quality.hpp"
+#include "skinmesh/meshing/volume_mesh.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -21,6 +22,10 @@ nlohmann::json on_surface_error_json(const std::vector<Eigen::Vector3d>& vertice
                                      double shrink);
 
 void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q);
+
+// The same for tetrahedral meshes (regions, boundary match included).
+nlohmann::json tet_report(const TetMesh& mesh, const TetQuality& q);
+void print_tet_quality(std::ostream& out, const TetQuality& q);
 
 // A bar chart of the smallest angle per triangle, written by the tool itself.
 void write_svg(std::ostream& out, const MeshQuality& q, const std::string& title);

@@ -199,6 +199,14 @@ TEST_CASE("skinmesh volume writes VTU, Gmsh and TetGen files with a report", "[c
                     " --domain both --box-margin 4 --report " + report.path());
   INFO(r.output);
   REQUIRE(r.code == 0);
+  // quality grades the written volume mesh: its boundary is exactly its marked faces.
+  const Run graded = run("--json quality " + stem + ".msh");
+  INFO(graded.output);
+  REQUIRE(graded.code == 0);
+  const nlohmann::json g = nlohmann::json::parse(graded.output);
+  CHECK(g["boundary_faces_not_marked"] == 0);
+  CHECK(g["marked_faces_not_on_boundary"] == 0);
+  CHECK(g["inverted"] == 0);
   for (const char* ext : {".vtu", ".msh", ".node", ".ele", ".face"}) {
     std::ifstream in(stem + ext);
     CHECK(in.good());

@@ -331,10 +331,17 @@ SurfaceMesh read_msms(const std::string& path) {
   return mesh;
 }
 
-// Gmsh MSH 4.x ASCII: the nodes of every entity block, and the triangles
-// (type 2) and quadrangles (type 3) of the element blocks; other element
-// types (lines, points, volumes) are skipped.
-SurfaceMesh read_gmsh(const std::string& path) {
+// Gmsh MSH 4.x ASCII: the nodes of every entity block; triangles (type 2)
+// and quadrangles (type 3) with their entity tags, and tetrahedra (type 4)
+// with theirs; other element types (points, lines, other volumes) are skipped.
+struct GmshContent {
+  SurfaceMesh surface;
+  std::vector<int> triangle_entity;
+  std::vector<std::array<int, 4>> tets;
+  std::vector<int> tet_entity;
+};
+
+GmshContent read_gmsh_content(const std::string& path) {
   const std::string text = read_all(path);
   Tokens t = tokenize(text, path);
   auto seek = [&](const char* section) {
@@ -349,7 +356,8 @@ SurfaceMesh read_gmsh(const std::string& path) {
   if (t.integer() != 0) input_error(path, at, "binary Gmsh files are not read (save as ASCII)");
   t.next = 0;
   seek("$Nodes");
-  SurfaceMesh mesh;
+  GmshContent out;
+  SurfaceMesh& mesh = out.surface;
   std::map<long, int> index;
   const long node_blocks = t.integer();
   t.integer();  // number of nodes
@@ -374,12 +382,12 @@ SurfaceMesh read_gmsh(const std::string& path) {
   t.integer();
   t.integer();
   t.integer();
+  const std::map<long, int> corners_of{{15, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 4}, {5, 8}, {6, 6}, {7, 5}};
   for (long b = 0; b < element_blocks; ++b) {
     t.integer();  // entity dimension
-    t.integer();  // entity tag
+    const long entity = t.integer();
     const long block_line = t.line();
     const long type = t.integer(), count = t.integer();
-    const std::map<long, int> corners_of{{15, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 4}, {5, 8}, {6, 6}, {7, 5}};
     const auto known = corners_of.find(type);
     if (known == corners_of.end()) input_error(path, block_line, "unsupported Gmsh element type " + std::to_string(type));
     for (long e = 0; e < count; ++e) {
@@ -392,7 +400,79 @@ SurfaceMesh read_gmsh(const std::string& path) {
         if (it == index.end()) input_error(path, line, "element refers to node " + std::to_string(tag) + ", not in $Nodes");
         corners.push_back(it->second);
       }
-      if (type == 2 || type == 3) add_polygon(mesh, corners, path, line);
+      if (type == 2 || type == 3) {
+        add_polygon(mesh, corners, path, line);
+        out.triangle_entity.resize(mesh.triangles.size(), static_cast<int>(entity));
+      } else if (type == 4) {
+        out.tets.push_back({static_cast<int>(corners[0]), static_cast<int>(corners[1]), static_cast<int>(corners[2]),
+                            static_cast<int>(corners[3])});
+        out.tet_entity.push_back(static_cast<int>(entity));
+      }
+    }
+  }
+  return out;
+}
+
+SurfaceMesh read_gmsh(const std::string& path) { return read_gmsh_content(path).surface; }
+
+// TetGen's files: "<count> <fields...>" headers, one numbered item a line,
+// '#' comments; `stem` is the name without .node/.ele/.face.
+TetMesh read_tetgen(const std::string& stem) {
+  TetMesh mesh;
+  {
+    const std::string path = stem + ".node";
+    Tokens t = tokenize(read_all(path), path);
+    const long n = t.integer(), dim = t.integer(), attributes = t.integer(), markers = t.integer();
+    if (dim != 3) input_error(path, 1, "not a 3D .node file");
+    if (n < 0 || attributes < 0 || markers < 0) input_error(path, 1, "negative count");
+    std::vector<long> numbers;
+    for (long i = 0; i < n; ++i) {
+      const long line = t.line();
+      numbers.push_back(t.integer());
+      const double x = t.number(), y = t.number(), z = t.number();
+      mesh.points.push_back(checked_point(x, y, z, path, line));
+      for (long k = 0; k < attributes + markers; ++k) t.number();
+    }
+    // Indices may start at 0 or 1 (TetGen keeps the input's numbering).
+    const long first = numbers.empty() ? 0 : *std::min_element(numbers.begin(), numbers.end());
+    if (first != 0 && first != 1) input_error(path, 2, "node numbers start at " + std::to_string(first));
+    const std::string ele = stem + ".ele";
+    Tokens e = tokenize(read_all(ele), ele);
+    const long m = e.integer(), corners = e.integer(), ele_attributes = e.integer();
+    if (corners != 4) input_error(ele, 1, "only 4-node tetrahedra are read");
+    for (long i = 0; i < m; ++i) {
+      const long line = e.line();
+      e.integer();
+      std::array<int, 4> tet{};
+      for (int k = 0; k < 4; ++k) {
+        const long v = e.integer() - first;
+        if (v < 0 || v >= n) input_error(ele, line, "tetrahedron refers to node " + std::to_string(v + first));
+        tet[static_cast<size_t>(k)] = static_cast<int>(v);
+      }
+      mesh.tets.push_back(tet);
+      double region = 0;
+      for (long k = 0; k < ele_attributes; ++k) {
+        const double a = e.number();
+        if (k == 0) region = a;
+      }
+      mesh.tet_region.push_back(static_cast<int>(std::lround(region)));
+    }
+    const std::string face = stem + ".face";
+    if (std::ifstream(face).good()) {
+      Tokens f = tokenize(read_all(face), face);
+      const long nf = f.integer(), with_markers = f.integer();
+      for (long i = 0; i < nf; ++i) {
+        const long line = f.line();
+        f.integer();
+        std::array<int, 3> tri{};
+        for (int k = 0; k < 3; ++k) {
+          const long v = f.integer() - first;
+          if (v < 0 || v >= n) input_error(face, line, "face refers to node " + std::to_string(v + first));
+          tri[static_cast<size_t>(k)] = static_cast<int>(v);
+        }
+        mesh.faces.push_back(tri);
+        mesh.face_marker.push_back(with_markers ? static_cast<int>(f.integer()) : 0);
+      }
     }
   }
   return mesh;
@@ -411,6 +491,25 @@ SurfaceMesh read_surface_mesh(const std::string& path) {
   else input_error(path, 0, "unknown mesh format (expected .off, .obj, .stl, .ply, .msh, or an MSMS .vert/.face pair)");
   if (mesh.triangles.empty()) input_error(path, 0, "mesh has no triangles");
   return mesh;
+}
+
+TetMesh read_tet_mesh(const std::string& path) {
+  for (const char* ext : {".node", ".ele", ".face"})
+    if (has_extension(path, ext)) return read_tetgen(path.substr(0, path.size() - std::string(ext).size()));
+  if (!has_extension(path, ".msh")) input_error(path, 0, "unknown volume mesh format (expected .ele/.node/.face or .msh)");
+  GmshContent g = read_gmsh_content(path);
+  if (g.tets.empty()) input_error(path, 0, "no tetrahedra in the file");
+  TetMesh mesh;
+  mesh.points = std::move(g.surface.vertices);
+  mesh.tets = std::move(g.tets);
+  mesh.tet_region = std::move(g.tet_entity);
+  mesh.faces = std::move(g.surface.triangles);
+  mesh.face_marker = std::move(g.triangle_entity);
+  return mesh;
+}
+
+bool gmsh_has_tetrahedra(const std::string& path) {
+  return has_extension(path, ".msh") && !read_gmsh_content(path).tets.empty();
 }
 
 }  // namespace skinmesh

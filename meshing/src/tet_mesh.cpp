@@ -39,6 +39,7 @@ TetQuality grade_tet_mesh(const TetMesh& mesh) {
   q.points = static_cast<long>(mesh.points.size());
   q.tets = static_cast<long>(mesh.tets.size());
   q.min_dihedral = 180;
+  q.min_dihedral_off_boundary = 180;
   std::vector<char> on_boundary(mesh.points.size(), 0);
   for (const auto& f : mesh.faces)
     for (int v : f) on_boundary[static_cast<size_t>(v)] = 1;
@@ -63,9 +64,9 @@ TetQuality grade_tet_mesh(const TetMesh& mesh) {
     for (int i = 0; i < 4; ++i)
       for (int j = i + 1; j < 4; ++j) shortest = std::min(shortest, (p[i] - p[j]).norm());
     q.max_radius_edge = std::max(q.max_radius_edge, radius / shortest);
-    if (!on_boundary[static_cast<size_t>(t[0])] && !on_boundary[static_cast<size_t>(t[1])] &&
-        !on_boundary[static_cast<size_t>(t[2])] && !on_boundary[static_cast<size_t>(t[3])])
-      q.max_radius_edge_off_boundary = std::max(q.max_radius_edge_off_boundary, radius / shortest);
+    const bool inner = !on_boundary[static_cast<size_t>(t[0])] && !on_boundary[static_cast<size_t>(t[1])] &&
+                       !on_boundary[static_cast<size_t>(t[2])] && !on_boundary[static_cast<size_t>(t[3])];
+    if (inner) q.max_radius_edge_off_boundary = std::max(q.max_radius_edge_off_boundary, radius / shortest);
     // Outward normal of the face opposite each vertex.
     Eigen::Vector3d n[4];
     for (int k = 0; k < 4; ++k) {
@@ -80,6 +81,7 @@ TetQuality grade_tet_mesh(const TetMesh& mesh) {
       for (int l = k + 1; l < 4; ++l) {
         const double angle = 180.0 - std::acos(std::clamp(n[k].dot(n[l]), -1.0, 1.0)) * 180.0 / M_PI;
         q.min_dihedral = std::min(q.min_dihedral, angle);
+        if (inner) q.min_dihedral_off_boundary = std::min(q.min_dihedral_off_boundary, angle);
         q.max_dihedral = std::max(q.max_dihedral, angle);
       }
   }

@@ -5,6 +5,9 @@
 // temporary directory and its .node/.ele/.face files are read back.
 #include "skinmesh/meshing/volume_mesh.hpp"
 
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/meshing/mesh_io.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -130,20 +133,6 @@ void write_smesh(std::ostream& out, const std::vector<Eigen::Vector3d>& points,
   out << regions.size() << '\n';
   for (size_t r = 0; r < regions.size(); ++r)
     out << r << ' ' << xyz(regions[r].point) << ' ' << regions[r].region << " -1\n";
-}
-
-// Reads the next line that is not empty or a comment.
-bool next_line(std::istream& in, std::istringstream& line) {
-  std::string text;
-  while (std::getline(in, text)) {
-    const size_t hash = text.find('#');
-    if (hash != std::string::npos) text.resize(hash);
-    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    line.clear();
-    line.str(text);
-    return true;
-  }
-  return false;
 }
 
 std::string read_tail(const std::string& path) {
@@ -322,53 +311,10 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const VolumeOptions& optio
     throw VolumeMeshError("TetGen failed (" + command + "): " + read_tail(stem + ".log"));
 
   TetMesh mesh;
-  std::istringstream line;
-  {
-    std::ifstream in(stem + ".1.node");
-    long n = 0;
-    int dim = 0, attributes = 0, with_markers = 0;
-    if (!next_line(in, line) || !(line >> n >> dim >> attributes >> with_markers) || dim != 3)
-      throw VolumeMeshError("TetGen wrote no readable .node file: " + read_tail(stem + ".log"));
-    mesh.points.resize(static_cast<size_t>(n));
-    for (long i = 0; i < n; ++i) {
-      long index;
-      Eigen::Vector3d p;
-      if (!next_line(in, line) || !(line >> index >> p[0] >> p[1] >> p[2]) || index < 0 || index >= n)
-        throw VolumeMeshError("TetGen's .node file is truncated");
-      mesh.points[static_cast<size_t>(index)] = p;
-    }
-  }
-  {
-    std::ifstream in(stem + ".1.ele");
-    long n = 0;
-    int corners = 0, attributes = 0;
-    if (!next_line(in, line) || !(line >> n >> corners >> attributes) || corners != 4 || attributes < 1)
-      throw VolumeMeshError("TetGen wrote no readable .ele file");
-    for (long i = 0; i < n; ++i) {
-      long index;
-      std::array<int, 4> t{};
-      double region = 0;
-      if (!next_line(in, line) || !(line >> index >> t[0] >> t[1] >> t[2] >> t[3] >> region))
-        throw VolumeMeshError("TetGen's .ele file is truncated");
-      mesh.tets.push_back(t);
-      mesh.tet_region.push_back(static_cast<int>(std::lround(region)));
-    }
-  }
-  {
-    std::ifstream in(stem + ".1.face");
-    long n = 0;
-    int with_markers = 0;
-    if (!next_line(in, line) || !(line >> n >> with_markers) || with_markers != 1)
-      throw VolumeMeshError("TetGen wrote no readable .face file");
-    for (long i = 0; i < n; ++i) {
-      long index;
-      std::array<int, 3> t{};
-      int marker = 0;
-      if (!next_line(in, line) || !(line >> index >> t[0] >> t[1] >> t[2] >> marker))
-        throw VolumeMeshError("TetGen's .face file is truncated");
-      mesh.faces.push_back(t);
-      mesh.face_marker.push_back(marker);
-    }
+  try {
+    mesh = read_tet_mesh(stem + ".1.ele");
+  } catch (const InputError& e) {
+    throw VolumeMeshError(std::string("TetGen's output: ") + e.what() + "; " + read_tail(stem + ".log"));
   }
   // TetGen orients tetrahedra its own way; make every one positive.
   for (auto& t : mesh.tets) {

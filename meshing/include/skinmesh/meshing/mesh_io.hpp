@@ -5,6 +5,7 @@
 #pragma once
 
 #include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/meshing/volume_mesh.hpp"
 
 #include <string>
 
@@ -15,5 +16,15 @@ namespace skinmesh {
 // into triangles. STL corners are merged when their coordinates are identical.
 // Throws InputError naming the file and line.
 SurfaceMesh read_surface_mesh(const std::string& path);
+
+// A tetrahedral mesh: TetGen's .node/.ele/.face set (any one of the three
+// names; the .face file is optional) with regions from the first .ele
+// attribute and face markers, or a Gmsh 4.x ASCII .msh whose tetrahedra take
+// their volume entity's tag as region and triangles their surface entity's tag
+// as marker. Throws InputError naming the file and line.
+TetMesh read_tet_mesh(const std::string& path);
+
+// Whether a Gmsh file holds tetrahedra (then `quality` grades it as a volume).
+bool gmsh_has_tetrahedra(const std::string& path);
 
 }  // namespace skinmesh
