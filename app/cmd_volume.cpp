@@ -17,7 +17,6 @@
 
 #include <cmath>
 #include <iostream>
-#include <map>
 
 namespace skinmesh::app {
 
@@ -100,30 +99,17 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
       const auto& a = surface.mesh.vertices[static_cast<size_t>(t[0])];
       enclosed += a.dot(surface.mesh.vertices[static_cast<size_t>(t[1])].cross(surface.mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
     }
-    std::map<int, long> per_region;
-    for (int r : tets.tet_region) ++per_region[r];
-    nlohmann::json regions = nlohmann::json::object();
-    for (const auto& [r, n] : per_region)
-      regions[r == kRegionInterior ? "interior" : r == kRegionSolvent ? "solvent" : r == kRegionCavity ? "cavity" : "other"] =
-          {{"tetrahedra", n}, {"volume", region_volume(tets, r)}};
     const double interior = region_volume(tets, kRegionInterior);
-    nlohmann::json report = {
-        {"molecule", o->molecule.path},
-        {"domain", o->domain},
-        {"surface", to_json(sq)},
-        {"surface_self_intersections", {{"cgal_exact", sq.self_intersecting_pairs}, {"tetgen", tetgen_pairs}}},
-        {"tetrahedra", q.tets},
-        {"points", q.points},
-        {"min_dihedral_deg", q.min_dihedral},
-        {"max_dihedral_deg", q.max_dihedral},
-        {"max_radius_edge_ratio", q.max_radius_edge},
-        {"max_radius_edge_ratio_off_boundary", q.max_radius_edge_off_boundary},
-        {"min_dihedral_deg_off_boundary", q.min_dihedral_off_boundary},
-        {"inverted", q.inverted},
-        {"regions", regions},
-        {"enclosed_volume", enclosed},
-        {"bounds_met", q.max_radius_edge <= volume.max_radius_edge && q.min_dihedral >= volume.min_dihedral},
-        {"outputs", {o->output + ".vtu", o->output + ".msh", o->output + ".node", o->output + ".ele", o->output + ".face"}}};
+    nlohmann::json report = tet_report(tets, q);
+    report["molecule"] = o->molecule.path;
+    report["domain"] = o->domain;
+    report["surface"] = to_json(sq);
+    report["surface_self_intersections"] = {{"cgal_exact", sq.self_intersecting_pairs}, {"tetgen", tetgen_pairs}};
+    report["enclosed_volume"] = enclosed;
+    report["bounds_met"] = q.max_radius_edge <= volume.max_radius_edge && q.min_dihedral >= volume.min_dihedral;
+    report["outputs"] = {o->output + ".vtu", o->output + ".msh", o->output + ".node", o->output + ".ele",
+                         o->output + ".face"};
+    const nlohmann::json& regions = report["regions"];
     if (volume.domain != VolumeDomain::exterior)
       report["interior_volume_relative_difference"] = std::abs(interior - enclosed) / enclosed;
     write_file_atomically(o->output + ".vtu", [&](std::ostream& out) { write_vtu(out, tets); });

@@ -127,8 +127,13 @@ nlohmann::json tet_report(const TetMesh& mesh, const TetQuality& q) {
   std::map<int, long> counts;
   for (int r : mesh.tet_region) ++counts[r];
   nlohmann::json regions = nlohmann::json::object();
-  for (const auto& [r, n] : counts)
-    regions[std::to_string(r)] = {{"tetrahedra", n}, {"volume", region_volume(mesh, r)}};
+  for (const auto& [r, n] : counts) {
+    const std::string name = r == kRegionInterior ? "interior"
+                             : r == kRegionSolvent ? "solvent"
+                             : r == kRegionCavity  ? "cavity"
+                                                   : std::to_string(r);
+    regions[name] = {{"tetrahedra", n}, {"volume", region_volume(mesh, r)}};
+  }
   return {{"points", q.points},
           {"tetrahedra", q.tets},
           {"volume", q.volume},
