@@ -5,6 +5,7 @@
 #include "output_file.hpp"
 #include "quality_report.hpp"
 
+#include "skinmesh/core/error.hpp"
 #include "skinmesh/meshing/mesh_io.hpp"
 #include "skinmesh/meshing/mesh_quality.hpp"
 #include "skinmesh/meshing/volume_mesh.hpp"
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 namespace skinmesh::app {
 
@@ -36,15 +38,16 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
   cmd->add_flag("--tetgen", o->tetgen, "also count self-intersections with TetGen's -d check (a second opinion)");
   add_molecule_settings(*cmd, o->molecule);
   cmd->callback([o, &global, &exit_code]() {
-    // Tetrahedral meshes (TetGen's files, or a Gmsh file with tetrahedra).
-    const bool tetgen_files = [&] {
-      for (const char* ext : {".node", ".ele"})
-        if (o->mesh.size() > 5 && o->mesh.compare(o->mesh.size() - std::string(ext).size(), std::string::npos, ext) == 0)
-          return true;
-      return false;
-    }();
-    if (tetgen_files || gmsh_has_tetrahedra(o->mesh)) {
-      const TetMesh tets = read_tet_mesh(o->mesh);
+    // Tetrahedral meshes (TetGen's files, or a Gmsh file with tetrahedra); a
+    // Gmsh file is read once, whichever it holds.
+    const auto ends_with = [&](const std::string& ext) {
+      return o->mesh.size() > ext.size() && o->mesh.compare(o->mesh.size() - ext.size(), std::string::npos, ext) == 0;
+    };
+    std::optional<TetMesh> gmsh;
+    if (ends_with(".msh")) gmsh = read_gmsh_volume(o->mesh);
+    const bool tetgen_files = ends_with(".node") || ends_with(".ele");
+    if (tetgen_files || (gmsh && !gmsh->tets.empty())) {
+      const TetMesh tets = tetgen_files ? read_tet_mesh(o->mesh) : std::move(*gmsh);
       const TetQuality q = grade_tet_mesh(tets);
       json report = tet_report(tets, q);
       report["file"] = o->mesh;
@@ -64,7 +67,14 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
       exit_code = 0;
       return;
     }
-    const SurfaceMesh mesh = read_surface_mesh(o->mesh);
+    SurfaceMesh mesh;
+    if (gmsh) {
+      if (gmsh->faces.empty()) throw InputError(o->mesh, 0, "mesh has no triangles");
+      mesh.vertices = std::move(gmsh->points);
+      mesh.triangles = std::move(gmsh->faces);
+    } else {
+      mesh = read_surface_mesh(o->mesh);
+    }
     GradeOptions grade;
     grade.check_self_intersections = !o->no_self_intersections;
     const MeshQuality q = grade_mesh(mesh, grade);

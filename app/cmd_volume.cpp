@@ -12,7 +12,6 @@
 #include "skinmesh/meshing/skin_mesher.hpp"
 #include "skinmesh/meshing/volume_mesh.hpp"
 
-#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -93,12 +92,8 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
     const TetQuality q = grade_tet_mesh(tets);
     const long tetgen_pairs = tetgen_self_intersections(surface.mesh, volume.tetgen);
     // The interior's tetrahedra fill exactly what the skin encloses (its
-    // outer components minus kept cavities).
-    double enclosed = 0;
-    for (const auto& t : surface.mesh.triangles) {
-      const auto& a = surface.mesh.vertices[static_cast<size_t>(t[0])];
-      enclosed += a.dot(surface.mesh.vertices[static_cast<size_t>(t[1])].cross(surface.mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
-    }
+    // outer components minus kept cavities): the grader's signed volume.
+    const double enclosed = sq.volume;
     const double interior = region_volume(tets, kRegionInterior);
     nlohmann::json report = tet_report(tets, q);
     report["molecule"] = o->molecule.path;

@@ -415,6 +415,19 @@ GmshContent read_gmsh_content(const std::string& path) {
 
 SurfaceMesh read_gmsh(const std::string& path) { return read_gmsh_content(path).surface; }
 
+// `count` node numbers of one TetGen item, shifted to zero-based and checked.
+template <size_t count>
+std::array<int, count> tetgen_corners(Tokens& t, long first, long nodes, const std::string& path, long line,
+                                      const char* what) {
+  std::array<int, count> out{};
+  for (size_t k = 0; k < count; ++k) {
+    const long v = t.integer() - first;
+    if (v < 0 || v >= nodes) input_error(path, line, std::string(what) + " refers to node " + std::to_string(v + first));
+    out[k] = static_cast<int>(v);
+  }
+  return out;
+}
+
 // TetGen's files: "<count> <fields...>" headers, one numbered item a line,
 // '#' comments; `stem` is the name without .node/.ele/.face.
 TetMesh read_tetgen(const std::string& stem) {
@@ -443,13 +456,7 @@ TetMesh read_tetgen(const std::string& stem) {
     for (long i = 0; i < m; ++i) {
       const long line = e.line();
       e.integer();
-      std::array<int, 4> tet{};
-      for (int k = 0; k < 4; ++k) {
-        const long v = e.integer() - first;
-        if (v < 0 || v >= n) input_error(ele, line, "tetrahedron refers to node " + std::to_string(v + first));
-        tet[static_cast<size_t>(k)] = static_cast<int>(v);
-      }
-      mesh.tets.push_back(tet);
+      mesh.tets.push_back(tetgen_corners<4>(e, first, n, ele, line, "tetrahedron"));
       double region = 0;
       for (long k = 0; k < ele_attributes; ++k) {
         const double a = e.number();
@@ -464,13 +471,7 @@ TetMesh read_tetgen(const std::string& stem) {
       for (long i = 0; i < nf; ++i) {
         const long line = f.line();
         f.integer();
-        std::array<int, 3> tri{};
-        for (int k = 0; k < 3; ++k) {
-          const long v = f.integer() - first;
-          if (v < 0 || v >= n) input_error(face, line, "face refers to node " + std::to_string(v + first));
-          tri[static_cast<size_t>(k)] = static_cast<int>(v);
-        }
-        mesh.faces.push_back(tri);
+        mesh.faces.push_back(tetgen_corners<3>(f, first, n, face, line, "face"));
         mesh.face_marker.push_back(with_markers ? static_cast<int>(f.integer()) : 0);
       }
     }
@@ -493,12 +494,8 @@ SurfaceMesh read_surface_mesh(const std::string& path) {
   return mesh;
 }
 
-TetMesh read_tet_mesh(const std::string& path) {
-  for (const char* ext : {".node", ".ele", ".face"})
-    if (has_extension(path, ext)) return read_tetgen(path.substr(0, path.size() - std::string(ext).size()));
-  if (!has_extension(path, ".msh")) input_error(path, 0, "unknown volume mesh format (expected .ele/.node/.face or .msh)");
+TetMesh read_gmsh_volume(const std::string& path) {
   GmshContent g = read_gmsh_content(path);
-  if (g.tets.empty()) input_error(path, 0, "no tetrahedra in the file");
   TetMesh mesh;
   mesh.points = std::move(g.surface.vertices);
   mesh.tets = std::move(g.tets);
@@ -508,8 +505,13 @@ TetMesh read_tet_mesh(const std::string& path) {
   return mesh;
 }
 
-bool gmsh_has_tetrahedra(const std::string& path) {
-  return has_extension(path, ".msh") && !read_gmsh_content(path).tets.empty();
+TetMesh read_tet_mesh(const std::string& path) {
+  for (const char* ext : {".node", ".ele", ".face"})
+    if (has_extension(path, ext)) return read_tetgen(path.substr(0, path.size() - std::string(ext).size()));
+  if (!has_extension(path, ".msh")) input_error(path, 0, "unknown volume mesh format (expected .ele/.node/.face or .msh)");
+  TetMesh mesh = read_gmsh_volume(path);
+  if (mesh.tets.empty()) input_error(path, 0, "no tetrahedra in the file");
+  return mesh;
 }
 
 }  // namespace skinmesh

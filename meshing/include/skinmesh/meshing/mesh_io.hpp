@@ -24,7 +24,9 @@ SurfaceMesh read_surface_mesh(const std::string& path);
 // as marker. Throws InputError naming the file and line.
 TetMesh read_tet_mesh(const std::string& path);
 
-// Whether a Gmsh file holds tetrahedra (then `quality` grades it as a volume).
-bool gmsh_has_tetrahedra(const std::string& path);
+// Everything in a Gmsh 4.x ASCII file as a TetMesh: its tetrahedra (possibly
+// none) and its triangles with their markers, read once; `quality` grades it
+// as a volume when it has tetrahedra and as a surface otherwise.
+TetMesh read_gmsh_volume(const std::string& path);
 
 }  // namespace skinmesh
