@@ -82,8 +82,9 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
     volume.keep_cavities = !o->drop_cavities;
     if (progress) std::cerr << "skinmesh: " << surface.mesh.triangles.size() << " skin triangles; running TetGen\n";
     TetMesh tets;
+    TetImprovement smoothing;
     try {
-      tets = tetrahedralize(surface.mesh, volume);
+      tets = tetrahedralize(surface.mesh, volume, &smoothing);
     } catch (const VolumeMeshError& e) {
       std::cerr << "skinmesh: error: " << o->molecule.path << ": " << e.what() << "\n";
       exit_code = 3;
@@ -101,7 +102,12 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
     report["surface"] = to_json(sq);
     report["surface_self_intersections"] = {{"cgal_exact", sq.self_intersecting_pairs}, {"tetgen", tetgen_pairs}};
     report["enclosed_volume"] = enclosed;
-    report["bounds_met"] = q.max_radius_edge <= volume.max_radius_edge && q.min_dihedral >= volume.min_dihedral;
+    const bool bounds_met = q.max_radius_edge <= volume.max_radius_edge && q.min_dihedral >= volume.min_dihedral;
+    report["bounds"] = {{"max_radius_edge", volume.max_radius_edge}, {"min_dihedral", volume.min_dihedral}};
+    report["bounds_met"] = bounds_met;
+    report["smoothing"] = {{"out_of_bounds_from_tetgen", smoothing.bad_before},
+                           {"out_of_bounds_after", smoothing.bad_after},
+                           {"points_moved", smoothing.moved}, {"edges_removed", smoothing.flips}};
     report["outputs"] = {o->output + ".vtu", o->output + ".msh", o->output + ".node", o->output + ".ele",
                          o->output + ".face"};
     const nlohmann::json& regions = report["regions"];
@@ -120,6 +126,10 @@ void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_co
       std::cout << o->output << ".{vtu,msh,node,ele,face}: " << q.tets << " tetrahedra, " << q.points << " points ("
                 << o->domain << ")\n";
       print_tet_quality(std::cout, q);
+      std::cout << "  bounds (radius-edge <= " << volume.max_radius_edge << ", dihedral >= " << volume.min_dihedral
+                << " deg): " << (bounds_met ? "met" : "NOT met") << "; TetGen left " << smoothing.bad_before
+                << " tetrahedra outside, " << smoothing.moved << " of its points moved, " << smoothing.flips << " edges removed, " << smoothing.bad_after
+                << " left\n";
       for (const auto& [name, r] : regions.items())
         std::cout << "  region " << name << ": " << r["tetrahedra"].get<long>() << " tetrahedra, volume "
                   << r["volume"].get<double>() << " A^3\n";

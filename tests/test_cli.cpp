@@ -218,6 +218,16 @@ TEST_CASE("skinmesh volume writes VTU, Gmsh and TetGen files with a report", "[c
   CHECK(j["regions"].contains("solvent"));
   CHECK(j["regions"].contains("cavity"));
   CHECK(j["interior_volume_relative_difference"].get<double>() <= 1e-9);
+  // What a solver needs to hear: a closed, oriented, manifold skin without
+  // self-intersections (both checks), and elements within the bounds asked.
+  CHECK(j["surface"]["closed"] == true);
+  CHECK(j["surface"]["manifold"] == true);
+  CHECK(j["surface_self_intersections"]["cgal_exact"] == 0);
+  CHECK(j["surface_self_intersections"]["tetgen"] == 0);
+  CHECK(j["bounds_met"] == true);
+  CHECK(j["max_radius_edge_ratio"].get<double>() <= 2.0);
+  CHECK(j["min_dihedral_deg"].get<double>() >= 5.0);
+  CHECK(j["smoothing"]["out_of_bounds_after"] == 0);
 
   const Run bad = run("volume " + skinmesh::test::data_file("pept.pdb") + " -o " + stem + " --domain inside");
   CHECK(bad.code != 0);

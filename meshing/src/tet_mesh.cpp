@@ -1,6 +1,8 @@
 // Grading and writing tetrahedral meshes (see volume_mesh.hpp).
 #include "skinmesh/meshing/volume_mesh.hpp"
 
+#include "tet_shape.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -44,46 +46,23 @@ TetQuality grade_tet_mesh(const TetMesh& mesh) {
   for (const auto& f : mesh.faces)
     for (int v : f) on_boundary[static_cast<size_t>(v)] = 1;
   for (const auto& t : mesh.tets) {
-    const double v = tet_volume(mesh, t);
-    q.volume += v;
-    if (!(v > 0)) {
+    const detail::TetShape s =
+        detail::tet_shape(mesh.points[static_cast<size_t>(t[0])], mesh.points[static_cast<size_t>(t[1])],
+                          mesh.points[static_cast<size_t>(t[2])], mesh.points[static_cast<size_t>(t[3])]);
+    q.volume += s.volume;
+    if (!(s.volume > 0)) {
       ++q.inverted;
       continue;
     }
-    Eigen::Vector3d p[4];
-    for (int k = 0; k < 4; ++k) p[k] = mesh.points[static_cast<size_t>(t[static_cast<size_t>(k)])];
-    // Circumcentre relative to p0: 2 (p_i - p0) . c = |p_i - p0|^2.
-    Eigen::Matrix3d A;
-    Eigen::Vector3d rhs;
-    for (int i = 1; i < 4; ++i) {
-      A.row(i - 1) = 2.0 * (p[i] - p[0]).transpose();
-      rhs[i - 1] = (p[i] - p[0]).squaredNorm();
-    }
-    const double radius = A.fullPivLu().solve(rhs).norm();
-    double shortest = INFINITY;
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) shortest = std::min(shortest, (p[i] - p[j]).norm());
-    q.max_radius_edge = std::max(q.max_radius_edge, radius / shortest);
     const bool inner = !on_boundary[static_cast<size_t>(t[0])] && !on_boundary[static_cast<size_t>(t[1])] &&
                        !on_boundary[static_cast<size_t>(t[2])] && !on_boundary[static_cast<size_t>(t[3])];
-    if (inner) q.max_radius_edge_off_boundary = std::max(q.max_radius_edge_off_boundary, radius / shortest);
-    // Outward normal of the face opposite each vertex.
-    Eigen::Vector3d n[4];
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d& a = p[(k + 1) % 4];
-      const Eigen::Vector3d& b = p[(k + 2) % 4];
-      const Eigen::Vector3d& c = p[(k + 3) % 4];
-      n[k] = (b - a).cross(c - a).normalized();
-      if (n[k].dot(p[k] - a) > 0) n[k] = -n[k];
+    q.max_radius_edge = std::max(q.max_radius_edge, s.radius_edge);
+    q.min_dihedral = std::min(q.min_dihedral, s.min_dihedral);
+    q.max_dihedral = std::max(q.max_dihedral, s.max_dihedral);
+    if (inner) {
+      q.max_radius_edge_off_boundary = std::max(q.max_radius_edge_off_boundary, s.radius_edge);
+      q.min_dihedral_off_boundary = std::min(q.min_dihedral_off_boundary, s.min_dihedral);
     }
-    // The dihedral angle at the edge shared by faces k and l.
-    for (int k = 0; k < 4; ++k)
-      for (int l = k + 1; l < 4; ++l) {
-        const double angle = 180.0 - std::acos(std::clamp(n[k].dot(n[l]), -1.0, 1.0)) * 180.0 / M_PI;
-        q.min_dihedral = std::min(q.min_dihedral, angle);
-        if (inner) q.min_dihedral_off_boundary = std::min(q.min_dihedral_off_boundary, angle);
-        q.max_dihedral = std::max(q.max_dihedral, angle);
-      }
   }
   if (mesh.tets.empty()) q.min_dihedral = 0;
   return q;

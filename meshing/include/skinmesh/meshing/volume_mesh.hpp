@@ -2,7 +2,8 @@
 // (Debian's `tetgen`): the molecule's interior, the solvent between the skin
 // and a box around it, or both, with region and boundary markers. The skin's
 // triangles stay as they are (no Steiner points on the surface), so the tet
-// mesh's boundary is the surface mesh itself.
+// mesh's boundary is the surface mesh itself; the few tetrahedra TetGen then
+// leaves outside the quality bounds are mended by improve_tet_mesh.
 #pragma once
 
 #include "skinmesh/core/surface_mesh.hpp"
@@ -51,13 +52,28 @@ class VolumeMeshError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The surface must be closed, manifold and outward oriented (as skinmesh
-// writes it); components with negative enclosed volume are cavities.
-TetMesh tetrahedralize(const SurfaceMesh& surface, const VolumeOptions& options = {});
 
 // A second opinion on self-intersections, independent of CGAL: TetGen's -d
 // check of the surface. Returns the number of intersecting triangle pairs.
 long tetgen_self_intersections(const SurfaceMesh& surface, const std::string& tetgen = "tetgen");
+
+// Brings tetrahedra TetGen left outside radius-edge <= max_radius_edge or
+// dihedral angles >= min_dihedral degrees within them: moves the points it
+// added (those on no face of `mesh.faces`) and removes edges on no face. The
+// faces, the points on them and every region's volume stay as they are.
+struct TetImprovement {
+  long bad_before = 0, bad_after = 0;  // tetrahedra outside the bounds
+  long moved = 0;                      // points moved
+  long flips = 0;                      // edges removed (ring of tetrahedra retriangulated)
+};
+TetImprovement improve_tet_mesh(TetMesh& mesh, double max_radius_edge, double min_dihedral);
+
+// The surface must be closed, manifold and outward oriented (as skinmesh
+// writes it); components with negative enclosed volume are cavities.
+// TetGen's result is passed through improve_tet_mesh with the options'
+// bounds; what that did is stored in *smoothing when given.
+TetMesh tetrahedralize(const SurfaceMesh& surface, const VolumeOptions& options = {},
+                       TetImprovement* smoothing = nullptr);
 
 // Quality of a tetrahedral mesh.
 struct TetQuality {
@@ -65,11 +81,9 @@ struct TetQuality {
   double volume = 0;                   // Angstrom^3, all tetrahedra
   double min_dihedral = 0, max_dihedral = 0;  // degrees
   double max_radius_edge = 0;          // circumradius / shortest edge
-  // The same over tetrahedra with no vertex on a boundary face. TetGen keeps
-  // the surface unsplit (-Y), and some tetrahedra against it cannot be
-  // refined: they may miss the requested bounds (measured: ratio up to 2.18
-  // for 2.0, dihedral down to 4.2 for 5 on 1ubi); away from the surface the
-  // bounds hold on the molecules tested.
+  // The same over tetrahedra with no vertex on a boundary face (the
+  // surface's neighbourhood is where TetGen, forbidden to split the surface,
+  // leaves tetrahedra outside its bounds).
   double max_radius_edge_off_boundary = 0;
   double min_dihedral_off_boundary = 0;  // degrees, same tetrahedra
   long inverted = 0;                   // tetrahedra with volume <= 0
