@@ -37,7 +37,8 @@ json describe(const Molecule& m, const MoleculeOptions& o) {
     entry.second = a.radius;
   }
   json radii_json = json::array();
-  const bool text_radii = m.format == MoleculeFormat::Pqr || m.format == MoleculeFormat::Xyzr;
+  const bool text_radii =
+      m.format == MoleculeFormat::Pqr || m.format == MoleculeFormat::Xyzr || m.format == MoleculeFormat::Wpts;
   for (const auto& [element, entry] : radii) {
     json r{{"element", element}, {"atoms", entry.first}};
     if (text_radii) {
@@ -62,7 +63,7 @@ json describe(const Molecule& m, const MoleculeOptions& o) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto counts = sc.cell_counts();
   j["shrink"] = o.shrink;
-  j["weights"] = convention_name(o.convention());
+  j["weights"] = m.format == MoleculeFormat::Wpts ? "as given (weighted points)" : convention_name(o.convention());
   j["regular_triangulation_dimension"] = sc.triangulation_dimension();
   j["mixed_cells"] = {{"vertex", counts[0]}, {"edge", counts[1]}, {"triangle", counts[2]}, {"tetrahedron", counts[3]},
                       {"total", counts[0] + counts[1] + counts[2] + counts[3]}};

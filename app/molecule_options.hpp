@@ -38,7 +38,7 @@ inline void add_molecule_settings(CLI::App& cmd, MoleculeOptions& o) {
 
 // The molecule as the subcommand's positional argument, plus its settings.
 inline void add_molecule_options(CLI::App& cmd, MoleculeOptions& o) {
-  cmd.add_option("molecule", o.path, "PDB, mmCIF (.cif), PQR or XYZR file, optionally .gz")->required();
+  cmd.add_option("molecule", o.path, "PDB, mmCIF (.cif), PQR, XYZR or weighted points (.wpts), optionally .gz")->required();
   add_molecule_settings(cmd, o);
 }
 

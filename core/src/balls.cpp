@@ -2,6 +2,8 @@
 
 #include "skinmesh/core/molecule.hpp"
 
+#include <cstdio>
+#include <sstream>
 #include <stdexcept>
 
 namespace skinmesh {
@@ -18,9 +20,25 @@ std::vector<Ball> balls_from_molecule(const Molecule& molecule, double shrink,
   balls.reserve(molecule.atoms.size());
   for (const Atom& atom : molecule.atoms) {
     const double r2 = atom.radius * atom.radius;
-    balls.push_back({atom.position, convention == WeightConvention::GrowBySkin ? r2 / shrink : r2});
+    if (atom.weight) balls.push_back({atom.position, *atom.weight});
+    else balls.push_back({atom.position, convention == WeightConvention::GrowBySkin ? r2 / shrink : r2});
   }
   return balls;
+}
+
+void write_wpts(std::ostream& out, const std::vector<Ball>& balls, const std::string& comment) {
+  out << "# skinmesh weighted points: x y z w (Angstrom, Angstrom^2); power distance |x - z|^2 - w\n";
+  if (!comment.empty()) {
+    std::istringstream lines(comment);
+    std::string line;
+    while (std::getline(lines, line)) out << "# " << line << '\n';
+  }
+  char buffer[128];
+  for (const Ball& b : balls) {
+    std::snprintf(buffer, sizeof buffer, "%.17g %.17g %.17g %.17g\n", b.center[0], b.center[1], b.center[2],
+                  b.weight);
+    out << buffer;
+  }
 }
 
 }  // namespace skinmesh

@@ -24,6 +24,7 @@ const char* format_name(MoleculeFormat format) {
     case MoleculeFormat::Mmcif: return "mmCIF";
     case MoleculeFormat::Pqr: return "PQR";
     case MoleculeFormat::Xyzr: return "XYZR";
+    case MoleculeFormat::Wpts: return "weighted points";
   }
   return "?";
 }
@@ -46,6 +47,7 @@ std::vector<detail::RawModel> read_raw_models(const std::string& path, MoleculeF
     case MoleculeFormat::Mmcif: return detail::read_pdb_or_mmcif(path, std::move(text), format, warnings);
     case MoleculeFormat::Pqr: return detail::read_pqr(path, text);
     case MoleculeFormat::Xyzr: return detail::read_xyzr(path, text);
+    case MoleculeFormat::Wpts: return detail::read_wpts(path, text);
   }
   return {};
 }
@@ -127,7 +129,7 @@ Molecule filter_model(const std::string& path, MoleculeFormat format, detail::Ra
         a.radius = options.unknown_radius;
         ++m.unknown_elements[a.element.empty() ? "?" : a.element];
       }
-    } else if (a.radius == 0.0) {
+    } else if (a.radius == 0.0 && !a.weight) {
       ++m.skipped["zero radius"];
       continue;
     }
@@ -187,6 +189,7 @@ MoleculeFormat format_from_path(const std::string& path) {
   if (has_extension(name, ".cif") || has_extension(name, ".mmcif")) return MoleculeFormat::Mmcif;
   if (has_extension(name, ".pqr")) return MoleculeFormat::Pqr;
   if (has_extension(name, ".xyzr") || has_extension(name, ".xyzrn")) return MoleculeFormat::Xyzr;
+  if (has_extension(name, ".wpts")) return MoleculeFormat::Wpts;
   return MoleculeFormat::Pdb;  // .pdb, .ent and anything else: PDB, which gemmi reads leniently
 }
 

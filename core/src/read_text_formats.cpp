@@ -1,10 +1,12 @@
-// PQR (whitespace-separated, as written by pdb2pqr and APBS) and XYZR
-// ("x y z r" per line, MSMS's input; anything after r is ignored).
+// PQR (whitespace-separated, as written by pdb2pqr and APBS), XYZR ("x y z r"
+// per line, MSMS's input; anything after r is ignored) and weighted points
+// ("x y z w" per line, exactly four numbers; '#' starts a comment).
 #include "reader_detail.hpp"
 
 #include "skinmesh/core/error.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <sstream>
 
 namespace skinmesh::detail {
@@ -118,6 +120,29 @@ std::vector<RawModel> read_xyzr(const std::string& path, const std::string& text
     model.push_back(std::move(r));
   });
   if (model.empty()) input_error(path, 0, "no atoms found (expected lines 'x y z r')");
+  return {model};
+}
+
+std::vector<RawModel> read_wpts(const std::string& path, const std::string& text) {
+  RawModel model;
+  for_each_line(text, [&](long number, const std::string& line) {
+    auto f = split_whitespace(line.substr(0, line.find('#')));
+    if (f.empty()) return;
+    if (f.size() != 4)
+      input_error(path, number,
+                  "weighted point line needs exactly 4 numbers 'x y z w', found " + std::to_string(f.size()) +
+                      " fields");
+    RawAtom r;
+    r.atom.position = parse_xyz(path, number, f[0], f[1], f[2]);
+    double w = 0;
+    if (!parse_finite_double(f[3], w)) input_error(path, number, "malformed or non-finite weight '" + f[3] + "'");
+    r.atom.weight = w;
+    r.atom.radius = w > 0 ? std::sqrt(w) : 0.0;  // for display only; the weight is what counts
+    r.radius_given = true;
+    r.atom.line = number;
+    model.push_back(std::move(r));
+  });
+  if (model.empty()) input_error(path, 0, "no weighted points found (expected lines 'x y z w')");
   return {model};
 }
 

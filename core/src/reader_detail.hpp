@@ -25,6 +25,7 @@ std::vector<RawModel> read_pdb_or_mmcif(const std::string& path, std::string tex
                                         MoleculeFormat format, std::vector<std::string>& warnings);
 std::vector<RawModel> read_pqr(const std::string& path, const std::string& text);
 std::vector<RawModel> read_xyzr(const std::string& path, const std::string& text);
+std::vector<RawModel> read_wpts(const std::string& path, const std::string& text);
 
 bool is_water_residue(const std::string& residue_name);
 

@@ -3,6 +3,8 @@
 
 #include <Eigen/Core>
 
+#include <ostream>
+#include <string>
 #include <vector>
 
 namespace skinmesh {
@@ -23,7 +25,14 @@ struct Ball {
 enum class WeightConvention { GrowBySkin, Raw };
 const char* convention_name(WeightConvention convention);
 
+// Atoms with a weight of their own (read from .wpts) keep it, whatever the
+// convention.
 std::vector<Ball> balls_from_molecule(const Molecule& molecule, double shrink,
                                       WeightConvention convention = WeightConvention::GrowBySkin);
+
+// The weighted-point format (.wpts): one ball per line, "x y z w" with the
+// weight w in Angstrom^2 (negative allowed), '#' comments; written with 17
+// significant digits so that reading it back gives the same doubles.
+void write_wpts(std::ostream& out, const std::vector<Ball>& balls, const std::string& comment = "");
 
 }  // namespace skinmesh

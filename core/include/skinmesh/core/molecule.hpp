@@ -1,10 +1,13 @@
 // Molecules as lists of atoms, read from PDB, mmCIF (plain or gzipped, through
-// gemmi), PQR and XYZR files, with the filters a structural biologist expects.
+// gemmi), PQR and XYZR files, with the filters a structural biologist expects;
+// and weighted point sets (.wpts: "x y z w" per line), which carry the balls'
+// weights themselves, negative ones included (an interpolated set of a morph).
 #pragma once
 
 #include <Eigen/Core>
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,10 +25,13 @@ struct Atom {
   char altloc = ' ';            // ' ' when the atom has a single conformer
   double occupancy = 1.0;
   long line = 0;                // 1-based line in the source file; 0 when unknown (mmCIF)
+  // The ball's weight as given by a .wpts file (Angstrom^2, any sign):
+  // balls_from_molecule takes it as is, with no radius convention.
+  std::optional<double> weight;
 };
 
 // Input formats, chosen from the file name (a trailing .gz is looked through).
-enum class MoleculeFormat { Pdb, Mmcif, Pqr, Xyzr };
+enum class MoleculeFormat { Pdb, Mmcif, Pqr, Xyzr, Wpts };
 const char* format_name(MoleculeFormat format);
 
 struct ReadOptions {
