@@ -14,5 +14,6 @@ void add_info_command(CLI::App& app, const GlobalOptions& global, int& exit_code
 void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
+void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 
 }  // namespace skinmesh::app

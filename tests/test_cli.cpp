@@ -234,3 +234,32 @@ TEST_CASE("skinmesh volume writes VTU, Gmsh and TetGen files with a report", "[c
   std::ifstream none(stem + ".vtu");
   CHECK(!none.good());
 }
+
+TEST_CASE("skinmesh interpolate writes the live pairs of B(t) as weighted points", "[cli][interpolation]") {
+  skinmesh::test::TempFile out("mid.wpts");
+  std::remove(out.path().c_str());
+  const std::string pept = skinmesh::test::data_file("pept.pdb"), al1 = skinmesh::test::data_file("3al1.pdb");
+  const Run r = run("--json interpolate " + pept + " " + al1 + " --t 0.25 --centre -o " + out.path());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  const nlohmann::json j = nlohmann::json::parse(r.output);
+  // Read back as a molecule: one ball per live pair, weights as written.
+  const skinmesh::Molecule m = skinmesh::read_molecule(out.path());
+  CHECK(static_cast<long>(m.atoms.size()) == j["balls"].get<long>());
+  CHECK(j["balls"].get<long>() < j["all_pairs"].get<long>());
+  long negative = 0;
+  for (const auto& a : m.atoms) negative += *a.weight < 0;
+  CHECK(negative == j["negative_weights"].get<long>());
+  CHECK(negative > 0);  // weights dip in the middle of a morph
+  // --all-pairs keeps m * n.
+  const Run all = run("--json interpolate " + pept + " " + al1 + " --all-pairs -o " + out.path());
+  REQUIRE(all.code == 0);
+  CHECK(skinmesh::read_molecule(out.path()).atoms.size() == nlohmann::json::parse(all.output)["all_pairs"].get<size_t>());
+  // XYZR cannot hold a negative weight: refused, nothing written.
+  skinmesh::test::TempFile xyzr("mid.xyzr");
+  std::remove(xyzr.path().c_str());
+  const Run refused = run("interpolate " + pept + " " + al1 + " -o " + xyzr.path());
+  CHECK(refused.code != 0);
+  CHECK(refused.output.find(".wpts") != std::string::npos);
+  CHECK(!std::ifstream(xyzr.path()).good());
+}

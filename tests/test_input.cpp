@@ -318,3 +318,33 @@ TEST_CASE("one, two, collinear and coplanar atoms build a complex", "[input][deg
     CHECK(sc.cells().size() >= sc.balls().size());
   }
 }
+
+TEST_CASE("weighted points (.wpts): weights as given, negative ones too, and bit-exact round trip", "[input][wpts]") {
+  const std::vector<Ball> balls = {{Eigen::Vector3d(0.1, -2.5, 3.0), 4.5},
+                                   {Eigen::Vector3d(1.0 / 3.0, 2.0 / 7.0, -1e-3), -0.7321},
+                                   {Eigen::Vector3d(5, 5, 5), 0.0}};
+  std::ostringstream text;
+  write_wpts(text, balls, "two lines\nof comment");
+  test::TempFile file("set.wpts", text.str());
+  const Molecule m = read_molecule(file.path());
+  CHECK(m.format == MoleculeFormat::Wpts);
+  REQUIRE(m.atoms.size() == balls.size());  // a zero or negative weight is kept, unlike a zero radius
+  // The weights are used as they are, whatever the convention asked for.
+  for (const WeightConvention c : {WeightConvention::GrowBySkin, WeightConvention::Raw}) {
+    const std::vector<Ball> back = balls_from_molecule(m, 0.5, c);
+    for (size_t i = 0; i < balls.size(); ++i) {
+      CHECK(back[i].center == balls[i].center);
+      CHECK(back[i].weight == balls[i].weight);
+    }
+  }
+  test::TempFile three("three.wpts", "# fine\n0 0 0 1\n1 2 3\n");
+  expect_input_error(three.path(), 3, "exactly 4 numbers");
+  test::TempFile five("five.wpts", "0 0 0 1 7\n");
+  expect_input_error(five.path(), 1, "exactly 4 numbers");
+  test::TempFile nan("nan.wpts", "0 0 0 1\n\n0 0 1 nan\n");
+  expect_input_error(nan.path(), 3, "weight");
+  test::TempFile word("word.wpts", "0 0 x 1\n");
+  expect_input_error(word.path(), 1, "z coordinate");
+  test::TempFile only_comments("empty.wpts", "# nothing\n\n");
+  expect_input_error(only_comments.path(), 0, "no weighted points");
+}

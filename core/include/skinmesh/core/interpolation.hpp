@@ -1,0 +1,38 @@
+// The interpolated ball set of a morph (MATH.md sections 1 and 4):
+// B(t) = { (1-t) a_i + t b_j }, and which of its m*n pairs matter.
+#pragma once
+
+#include "skinmesh/core/balls.hpp"
+
+#include <vector>
+
+namespace skinmesh {
+
+struct BallPair {
+  int source = 0, target = 0;  // indices into the source and target ball lists
+  bool operator==(const BallPair& o) const { return source == o.source && target == o.target; }
+  bool operator<(const BallPair& o) const {
+    return source != o.source ? source < o.source : target < o.target;
+  }
+};
+
+// b_ij(t): centre (1-t) z_i + t z_j, weight (1-t) w_i + t w_j - t(1-t) |z_i - z_j|^2.
+Ball interpolate_ball(const Ball& a, const Ball& b, double t);
+
+// Every pair (i, j), the m*n set.
+std::vector<BallPair> all_pairs(size_t m, size_t n);
+
+// The live pairs: those whose power cells, a_i's in the source's power
+// diagram and b_j's in the target's, overlap in an open set. For every t in
+// (0,1) these are exactly the balls of B(t) that are not hidden in its
+// regular triangulation (its power diagram is the overlay of the two, MATH.md
+// section 4), about m + n of them. Found by a walk over the overlay from the
+// pairs holding the balls' centres, each candidate tested by insertion into
+// the regular triangulation of B(1/2). Sorted.
+std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target);
+
+// The balls b_ij(t) of the given pairs, in their order.
+std::vector<Ball> interpolated_balls(const std::vector<Ball>& source, const std::vector<Ball>& target,
+                                     const std::vector<BallPair>& pairs, double t);
+
+}  // namespace skinmesh

@@ -1,0 +1,119 @@
+// The interpolated set of a morph and its live pairs (see interpolation.hpp).
+#include "skinmesh/core/interpolation.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <deque>
+#include <set>
+#include <stdexcept>
+#include <unordered_set>
+
+namespace skinmesh {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb0 = CGAL::Regular_triangulation_vertex_base_3<K>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<long, K, Vb0>;
+using Cb = CGAL::Regular_triangulation_cell_base_3<K>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
+using Regular = CGAL::Regular_triangulation_3<K, Tds>;
+using Weighted = K::Weighted_point_3;
+
+Weighted weighted(const Ball& b) { return Weighted(K::Point_3(b.center[0], b.center[1], b.center[2]), b.weight); }
+
+// The regular triangulation of one ball set: who is hidden, who neighbours
+// whom (power cells sharing a facet), and whose cell holds a point.
+struct PowerDiagram {
+  Regular rt;
+  std::vector<Regular::Vertex_handle> vertex;  // null for hidden balls
+  explicit PowerDiagram(const std::vector<Ball>& balls) : vertex(balls.size()) {
+    for (size_t i = 0; i < balls.size(); ++i) {
+      const auto v = rt.insert(weighted(balls[i]));
+      if (v != Regular::Vertex_handle()) v->info() = static_cast<long>(i);
+    }
+    for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v)
+      vertex[static_cast<size_t>(v->info())] = v;
+  }
+  std::vector<int> neighbours(int i) const {
+    std::vector<int> out;
+    const auto v = vertex[static_cast<size_t>(i)];
+    if (v == Regular::Vertex_handle() || rt.dimension() < 1) return out;
+    std::vector<Regular::Vertex_handle> adjacent;
+    rt.finite_adjacent_vertices(v, std::back_inserter(adjacent));
+    for (const auto& a : adjacent) out.push_back(static_cast<int>(a->info()));
+    return out;
+  }
+  int owner(const Eigen::Vector3d& x) const {
+    return static_cast<int>(rt.nearest_power_vertex(K::Point_3(x[0], x[1], x[2]))->info());
+  }
+};
+
+}  // namespace
+
+Ball interpolate_ball(const Ball& a, const Ball& b, double t) {
+  return {(1 - t) * a.center + t * b.center,
+          (1 - t) * a.weight + t * b.weight - t * (1 - t) * (a.center - b.center).squaredNorm()};
+}
+
+std::vector<BallPair> all_pairs(size_t m, size_t n) {
+  std::vector<BallPair> out;
+  out.reserve(m * n);
+  for (size_t i = 0; i < m; ++i)
+    for (size_t j = 0; j < n; ++j) out.push_back({static_cast<int>(i), static_cast<int>(j)});
+  return out;
+}
+
+std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target) {
+  if (source.empty() || target.empty()) throw std::invalid_argument("live_pairs: an empty ball set");
+  const PowerDiagram a(source), b(target);
+  const long n = static_cast<long>(target.size());
+  // The overlay's cells are connected through facets, and a facet between
+  // cells (i, j) and (i', j') lies on a facet of one diagram (i' a neighbour
+  // of i, or j' of j) or of both at once (coincident facets, when atoms do
+  // not move). Every live pair is thus reached from another live pair by
+  // changing i, j or both to a neighbour. A candidate hidden among the pairs
+  // inserted so far is hidden among all of them, so it is dead for good;
+  // one inserted alive may be hidden later, and the triangulation's
+  // vertices at the end are the live set.
+  Regular overlay;
+  std::unordered_set<long> seen;
+  std::deque<BallPair> queue;
+  auto push = [&](int i, int j) {
+    if (seen.insert(static_cast<long>(i) * n + j).second) queue.push_back({i, j});
+  };
+  // Seeds: the pairs whose overlay cells hold the balls' centres.
+  for (const Ball& ball : source) push(a.owner(ball.center), b.owner(ball.center));
+  for (const Ball& ball : target) push(a.owner(ball.center), b.owner(ball.center));
+  while (!queue.empty()) {
+    const BallPair p = queue.front();
+    queue.pop_front();
+    const Ball mid = interpolate_ball(source[static_cast<size_t>(p.source)], target[static_cast<size_t>(p.target)], 0.5);
+    const auto v = overlay.insert(weighted(mid));
+    if (v == Regular::Vertex_handle()) continue;  // hidden
+    v->info() = static_cast<long>(p.source) * n + p.target;
+    const std::vector<int> ni = a.neighbours(p.source), nj = b.neighbours(p.target);
+    for (int i : ni) push(i, p.target);
+    for (int j : nj) push(p.source, j);
+    for (int i : ni)
+      for (int j : nj) push(i, j);
+  }
+  std::vector<BallPair> out;
+  for (auto v = overlay.finite_vertices_begin(); v != overlay.finite_vertices_end(); ++v)
+    out.push_back({static_cast<int>(v->info() / n), static_cast<int>(v->info() % n)});
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<Ball> interpolated_balls(const std::vector<Ball>& source, const std::vector<Ball>& target,
+                                     const std::vector<BallPair>& pairs, double t) {
+  std::vector<Ball> out;
+  out.reserve(pairs.size());
+  for (const BallPair& p : pairs)
+    out.push_back(interpolate_ball(source.at(static_cast<size_t>(p.source)), target.at(static_cast<size_t>(p.target)), t));
+  return out;
+}
+
+}  // namespace skinmesh
