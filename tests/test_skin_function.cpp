@@ -1,6 +1,7 @@
 // The mixed-cell quadrics against the independent oracle of MATH.md section 2.
 #include "test_support.hpp"
 
+#include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
@@ -148,4 +149,93 @@ TEST_CASE("the oracle is certified on the skin and far from the origin", "[skin]
   CHECK(uncertified == 0);
   CHECK(worst <= 1e-9);
   CHECK(worst_moved <= 1e-6);  // 1000 A coordinates keep ~12 digits of the local geometry
+}
+
+namespace {
+
+std::vector<Ball> centred_molecule(const std::string& path, int model) {
+  ReadOptions read;
+  read.model = model;
+  std::vector<Ball> balls = balls_from_molecule(read_molecule(path, read), 0.5);
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Ball& b : balls) c += b.center;
+  c /= static_cast<double>(balls.size());
+  for (Ball& b : balls) b.center -= c;
+  return balls;
+}
+
+}  // namespace
+
+TEST_CASE("cospherical and interpolated ball sets: skin function and crossings equal the oracle",
+          "[skin][oracle][degenerate][segment]") {
+  const double s = 0.5, w = 1.5 * 1.5 / 0.5;
+  std::vector<std::pair<std::string, std::vector<Ball>>> sets;
+  {
+    std::vector<Ball> cube, square, hexagon, octahedron;
+    for (int i = 0; i < 8; ++i) cube.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, i & 4 ? 1.5 : -1.5), w});
+    for (int i = 0; i < 4; ++i) square.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, 0), w});
+    for (int i = 0; i < 6; ++i) hexagon.push_back({Eigen::Vector3d(2.5 * std::cos(i * M_PI / 3), 2.5 * std::sin(i * M_PI / 3), 0), w});
+    hexagon.push_back({Eigen::Vector3d(0, 0, 1.8), w});
+    hexagon.push_back({Eigen::Vector3d(0, 0, -1.8), w});
+    for (int k = 0; k < 3; ++k)
+      for (int sign = -1; sign <= 1; sign += 2) {
+        Eigen::Vector3d p = Eigen::Vector3d::Zero();
+        p[k] = 2.2 * sign;
+        octahedron.push_back({p, w});
+      }
+    sets = {{"cube", cube}, {"square", square}, {"hexagon with two on its axis", hexagon}, {"octahedron", octahedron}};
+  }
+  // The exact B(1/2) of two morphs (MATH.md 4): groups of balls orthogonal to
+  // one sphere everywhere, which CGAL splits into flat tetrahedra.
+  auto midway = [](const std::vector<Ball>& a, const std::vector<Ball>& b) {
+    return interpolated_balls(a, b, live_pairs(a, b), 0.5);
+  };
+  sets.push_back({"B(1/2) pept -> 3al1", midway(centred_molecule(test::data_file("pept.pdb"), 1),
+                                                centred_molecule(test::data_file("3al1.pdb"), 1))});
+  sets.push_back({"B(1/2) 2k39 model 1 -> 2", midway(centred_molecule(test::shared_pdb("2k39_3models.pdb"), 1),
+                                                     centred_molecule(test::shared_pdb("2k39_3models.pdb"), 2))});
+  for (const auto& [name, balls] : sets) {
+    INFO(name);
+    const SkinComplex sc = build_skin_complex(balls, {s});
+    if (name.rfind("B(1/2)", 0) == 0) CHECK(sc.degenerate_cell_count() > 0);  // flat cells are exercised
+    const auto points = test::sample_near_balls(balls, s, 4000, 2.0, 17);
+    const Agreement a = compare_with_oracle(balls, s, points);
+    INFO("worst relative " << a.worst_relative);
+    CHECK(a.uncertified == 0);
+    CHECK(a.sign_mismatches == 0);
+    CHECK(a.worst_relative <= 1e-9);
+    // Every crossing of a segment is on the skin by the oracle, and the sign
+    // of F changes between consecutive crossings as they say.
+    const SkinOracle oracle(balls, s);
+    long crossings = 0, off = 0, wrong_sign = 0;
+    for (size_t k = 0; k + 1 < points.size(); k += 2) {
+      const Eigen::Vector3d p = points[k], q = points[k] + 2.0 * (points[k + 1] - points[k]).normalized();
+      const auto found = sc.intersect_segment(p, q);
+      for (const SegmentCrossing& c : found) {
+        ++crossings;
+        if (oracle.evaluate(c.point).distance() > 1e-9) ++off;
+      }
+      // Between crossings (and before the first) F keeps one sign.
+      double t0 = 0;
+      for (size_t i = 0; i <= found.size(); ++i) {
+        const double t1 = i < found.size() ? found[i].t : 1.0;
+        if (t1 - t0 > 1e-6) {
+          const double mid = oracle.evaluate(p + 0.5 * (t0 + t1) * (q - p)).value;
+          const bool inside_expected = i < found.size() ? found[i].entering == false : (found.empty()
+                                                                                          ? oracle.evaluate(p).value < 0
+                                                                                          : found.back().entering);
+          if (std::abs(mid) > 1e-9 && (mid < 0) != inside_expected) {
+            ++wrong_sign;
+            WARN("sign: F " << mid << " on (" << t0 << ", " << t1 << ") of " << p.transpose() << " -> "
+                                     << q.transpose() << ", " << found.size() << " crossings");
+          }
+        }
+        t0 = t1;
+      }
+    }
+    INFO(crossings << " crossings");
+    CHECK(crossings > 100);
+    CHECK(off == 0);
+    CHECK(wrong_sign == 0);
+  }
 }

@@ -17,6 +17,8 @@
 namespace skinmesh {
 namespace {
 
+using SkinComplexCoface = SkinComplex::Coface;
+
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Vb0 = CGAL::Regular_triangulation_vertex_base_3<K>;
 using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, Vb0>;
@@ -82,6 +84,71 @@ void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
   cell.P = E * gram_inv * E.transpose();
   const Mat affine = gram_inv * E.transpose();
   for (int j = 0; j < d; ++j) cell.to_affine.row(j) = affine.row(j);
+}
+
+// A cell X whose coface Y is flat (see compute_cell_geometry) would take
+// from Y's balls no bound on its Voronoi part nu_X: they are co-orthogonal
+// with X's along it. The true bound comes from the cells beyond the flat
+// cluster (the flat cells of Y's dimension joined through shared faces):
+// every ball of such a cell T outside the cluster bounds nu_X, and a walk
+// leaving X that way goes on from T. Any ball gives a valid bound (nu_X is where X's
+// balls have the least power of all), so extra ones are safe.
+void add_constraints_beyond_flat_cofaces(std::vector<MixedCell>& cells, const std::vector<int>& faces,
+                                         const std::vector<int>& face_offset, std::vector<SkinComplexCoface>& cofaces,
+                                         std::vector<int>& coface_offset) {
+  const size_t m = cells.size();
+  std::vector<std::vector<SkinComplexCoface>> extra(m);
+  std::vector<char> in_cluster(m, 0);
+  for (size_t y = 0; y < m; ++y) {
+    if (!cells[y].degenerate || in_cluster[y]) continue;
+    std::vector<int> cluster{static_cast<int>(y)}, beyond;
+    in_cluster[y] = 1;
+    for (size_t k = 0; k < cluster.size(); ++k) {
+      const int member = cluster[k];
+      for (int f = face_offset[static_cast<size_t>(member)]; f < face_offset[static_cast<size_t>(member) + 1]; ++f) {
+        const int face = faces[static_cast<size_t>(f)];
+        for (int g = coface_offset[static_cast<size_t>(face)]; g < coface_offset[static_cast<size_t>(face) + 1]; ++g) {
+          const int other = cofaces[static_cast<size_t>(g)].cell;
+          if (cells[static_cast<size_t>(other)].degenerate) {
+            if (!in_cluster[static_cast<size_t>(other)]) {
+              in_cluster[static_cast<size_t>(other)] = 1;
+              cluster.push_back(other);
+            }
+          } else {
+            beyond.push_back(other);
+          }
+        }
+      }
+    }
+    // The cluster's own balls are co-orthogonal with X's along aff(nu_X):
+    // their bounds are void, so only the other balls of the cells beyond count.
+    std::vector<int> cluster_balls;
+    for (const int member : cluster)
+      for (int j = 0; j <= cells[static_cast<size_t>(member)].dim; ++j)
+        cluster_balls.push_back(cells[static_cast<size_t>(member)].balls[static_cast<size_t>(j)]);
+    std::sort(cluster_balls.begin(), cluster_balls.end());
+    for (const int member : cluster)
+      for (int f = face_offset[static_cast<size_t>(member)]; f < face_offset[static_cast<size_t>(member) + 1]; ++f) {
+        const int x = faces[static_cast<size_t>(f)];
+        if (cells[static_cast<size_t>(x)].degenerate) continue;
+        const auto& xb = cells[static_cast<size_t>(x)].balls;
+        for (const int t : beyond)
+          for (int j = 0; j <= cells[static_cast<size_t>(t)].dim; ++j) {
+            const int ball = cells[static_cast<size_t>(t)].balls[static_cast<size_t>(j)];
+            if (!std::binary_search(cluster_balls.begin(), cluster_balls.end(), ball))
+              extra[static_cast<size_t>(x)].push_back({ball, t, true});
+          }
+      }
+  }
+  std::vector<SkinComplexCoface> merged;
+  std::vector<int> offset(m + 1, 0);
+  for (size_t i = 0; i < m; ++i) {
+    merged.insert(merged.end(), cofaces.begin() + coface_offset[i], cofaces.begin() + coface_offset[i + 1]);
+    merged.insert(merged.end(), extra[i].begin(), extra[i].end());
+    offset[i + 1] = static_cast<int>(merged.size());
+  }
+  cofaces = std::move(merged);
+  coface_offset = std::move(offset);
 }
 
 }  // namespace
@@ -167,11 +234,12 @@ SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions
     const MixedCell& c = cells[i];
     for (int drop = 0; drop < (c.dim > 0 ? c.dim + 1 : 0); ++drop) {
       const int face = sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)];
-      sc.cofaces_[static_cast<size_t>(fill[static_cast<size_t>(face)]++)] = {c.balls[drop], static_cast<int>(i)};
+      sc.cofaces_[static_cast<size_t>(fill[static_cast<size_t>(face)]++)] = {c.balls[drop], static_cast<int>(i), false};
     }
   }
 
   for (MixedCell& c : cells) compute_cell_geometry(c, sc.balls_);
+  add_constraints_beyond_flat_cofaces(cells, sc.faces_, sc.face_offset_, sc.cofaces_, sc.coface_offset_);
 
   // Start-point grid over the centres of the non-hidden balls.
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());

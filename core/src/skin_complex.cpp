@@ -55,6 +55,10 @@ static Violation worst_violation(const SkinComplex& sc, int c, const Eigen::Vect
   const Eigen::Vector3d y = x - cell.center;
   const Eigen::Vector3d py = cell.P * y;
   Violation worst;
+  // A flat simplex (affinely dependent balls, from cospherical input split
+  // by CGAL's symbolic perturbation) has a mixed cell of zero volume: it holds
+  // no point, and a walk goes on through one of its faces.
+  if (cell.degenerate) return {std::numeric_limits<double>::max(), *sc.faces_begin(c)};
   const Ball& b0 = sc.balls()[static_cast<size_t>(cell.balls[0])];
   if (cell.dim > 0) {
     const Eigen::Vector3d d = cell.center + py / (1 - s);
@@ -71,6 +75,9 @@ static Violation worst_violation(const SkinComplex& sc, int c, const Eigen::Vect
   const Eigen::Vector3d v = cell.center + (y - py) / s;
   const double pi0 = b0.power(v);
   for (auto it = sc.cofaces_begin(c); it != sc.cofaces_end(c); ++it) {
+    // A flat coface's ball is co-orthogonal with X's along aff(nu_X): its
+    // bound is void (rounding noise); the cells beyond it bound nu_X instead.
+    if (sc.cell(it->cell).degenerate) continue;
     const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
     const double gap = (bk.center - b0.center).norm();
     const double slack = (bk.power(v) - pi0) / (2 * std::max(gap, 1e-300));  // signed distance to the bisector
@@ -261,23 +268,30 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
   const double s = shrink_;
   if (dir.squaredNorm() == 0.0) return out;
   int c = locate(a, hint);
-  double t = 0.0;
+  double t = 0.0;        // crossings are searched from here
+  double t_floor = 0.0;  // exits are searched from here (past a point stepped over)
   int stalled = 0;
   const int max_cells = 20000;
   for (int visit = 0; visit < max_cells; ++visit) {
     const MixedCell& cell = cells_[static_cast<size_t>(c)];
+    if (cell.degenerate) {  // holds nothing: continue from the cell really there
+      c = locate(a + t * dir, *faces_begin(c));
+      continue;
+    }
     const Ball& b0 = balls_[static_cast<size_t>(cell.balls[0])];
     const Eigen::Vector3d y0 = a - cell.center;
 
     // Where the segment leaves mu_c: every constraint is affine in t.
     double t_exit = std::numeric_limits<double>::infinity();
     int next = -1;
-    auto consider = [&](double value0, double slope, int target) {
+    bool next_beyond = false;
+    auto consider = [&](double value0, double slope, int target, bool beyond = false) {
       if (slope >= 0) return;
-      const double crossing = std::max(t, -value0 / slope);
+      const double crossing = std::max(t_floor, -value0 / slope);
       if (crossing < t_exit) {
         t_exit = crossing;
         next = target;
+        next_beyond = beyond;
       }
     };
     if (cell.dim > 0) {
@@ -296,10 +310,11 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
     const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
     const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;
     for (auto it = cofaces_begin(c); it != cofaces_end(c); ++it) {
+      if (cells_[static_cast<size_t>(it->cell)].degenerate) continue;  // void bound (see worst_violation)
       const Ball& bk = balls_[static_cast<size_t>(it->ball)];
       // pi_k(v) - pi_0(v) = -2 <v, z_k - z_0> + |z_k|^2 - w_k - |z_0|^2 + w_0
       const Eigen::Vector3d dz = bk.center - b0.center;
-      consider(bk.power(v0) - b0.power(v0), -2.0 * v1.dot(dz), it->cell);
+      consider(bk.power(v0) - b0.power(v0), -2.0 * v1.dot(dz), it->cell, it->beyond);
     }
 
     // Roots of Q_c(a + t dir) = A t^2 + B t + C on [t, min(t_exit, 1)].
@@ -332,20 +347,24 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
     }
     if (t_exit >= 1.0 || next < 0) break;
 
-    // Zero-length steps go round a face where several cells meet; after a few,
-    // step over it by locating slightly further along.
-    if (t_exit <= t) {
-      if (++stalled > 8) {
-        t = std::min(1.0, t + 1e-12);
-        c = locate(a + t * dir, c);
+    // Zero-length steps go round a face where several cells meet (many of
+    // them of zero size where balls are cospherical); after a few, locate
+    // slightly further along and go on from there. Crossings are still
+    // searched from t, with the quadric of the cell found, which equals the
+    // skin function there by continuity, so none is lost in the step.
+    if (t_exit <= t_floor) {
+      if (++stalled > 2) {
+        t_floor = std::min(1.0, t_floor + 1e-9);
+        c = locate(a + t_floor * dir, c);
         stalled = 0;
         continue;
       }
     } else {
       stalled = 0;
     }
-    t = t_exit;
-    c = next;
+    t = t_floor = t_exit;
+    // A cell past a flat coface is not adjacent: find the one really there.
+    c = next_beyond ? locate(a + t * dir, next) : next;
   }
   return out;
 }

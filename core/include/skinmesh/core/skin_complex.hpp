@@ -77,10 +77,14 @@ class SkinComplex {
   long degenerate_cell_count() const;
   int vertex_cell(int ball) const { return vertex_cell_[static_cast<size_t>(ball)]; }  // -1 if hidden
 
-  // Faces of a cell (X minus one ball; the i-th drops balls[i]) and cofaces (X plus one ball).
+  // Faces of a cell (X minus one ball; the i-th drops balls[i]) and cofaces
+  // (X plus one ball), each with the ball whose power bounds nu_X. Where a
+  // coface is flat (MixedCell::degenerate), the cells beyond its flat cluster
+  // follow, with their balls X lacks (see build_skin_complex.cpp).
   struct Coface {
     int ball;
     int cell;
+    bool beyond = false;  // a cell past a flat coface, not adjacent: walks locate from it
   };
   const int* faces_begin(int c) const { return faces_.data() + face_offset_[c]; }
   const int* faces_end(int c) const { return faces_.data() + face_offset_[c + 1]; }
