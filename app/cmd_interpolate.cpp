@@ -24,12 +24,7 @@ std::vector<Ball> read_balls(const std::string& path, ReadOptions read, int mode
   read.model = model;
   const Molecule m = read_molecule(path, read);
   std::vector<Ball> balls = balls_from_molecule(m, o.shrink, o.convention());
-  if (centre) {
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (const Ball& b : balls) c += b.center;
-    c /= static_cast<double>(balls.size());
-    for (Ball& b : balls) b.center -= c;
-  }
+  if (centre) centre_balls(balls);
   return balls;
 }
 

@@ -19,17 +19,6 @@ using namespace skinmesh;
 
 namespace {
 
-std::vector<Ball> centred_balls(const std::string& path, int model = 1) {
-  ReadOptions read;
-  read.model = model;
-  std::vector<Ball> balls = balls_from_molecule(read_molecule(path, read), 0.5);
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const Ball& b : balls) c += b.center;
-  c /= static_cast<double>(balls.size());
-  for (Ball& b : balls) b.center -= c;
-  return balls;
-}
-
 // The pairs whose ball b_ij(1/2) is a vertex of the regular triangulation of
 // all m*n balls.
 std::vector<BallPair> non_hidden_of_all_pairs(const std::vector<Ball>& a, const std::vector<Ball>& b) {
@@ -69,14 +58,14 @@ TEST_CASE("an interpolated ball's power is the interpolated power", "[interpolat
 }
 
 TEST_CASE("live pairs are the non-hidden balls of the full m*n set", "[interpolation]") {
-  const auto pept = centred_balls(test::data_file("pept.pdb"));
-  const auto al1 = centred_balls(test::data_file("3al1.pdb"));
+  const auto pept = test::centred_model(test::data_file("pept.pdb"), 1);
+  const auto al1 = test::centred_model(test::data_file("3al1.pdb"), 1);
   const auto live = live_pairs(pept, al1);
   CHECK(live == non_hidden_of_all_pairs(pept, al1));
   CHECK(live.size() < pept.size() * al1.size() / 10);  // about m + n, not m * n
 
-  const auto m1 = centred_balls(test::shared_pdb("2k39_3models.pdb"), 1);
-  const auto m2 = centred_balls(test::shared_pdb("2k39_3models.pdb"), 2);
+  const auto m1 = test::centred_model(test::shared_pdb("2k39_3models.pdb"), 1);
+  const auto m2 = test::centred_model(test::shared_pdb("2k39_3models.pdb"), 2);
   CHECK(live_pairs(m1, m2) == non_hidden_of_all_pairs(m1, m2));
 
   // Partial movement: most atoms stay, so the two power diagrams share

@@ -161,50 +161,11 @@ std::vector<Ball> jittered(std::vector<Ball> balls, unsigned seed = 1) {
 }
 
 TEST_CASE("mesher guarantees on cospherical and coplanar ball sets", "[mesher][degenerate]") {
-  const double w = 1.5 * 1.5 / 0.5;
-  std::vector<std::pair<std::string, std::vector<Ball>>> sets;
-  {
-    std::vector<Ball> cube;  // eight balls on the corners of a cube: one orthogonal sphere
-    for (int i = 0; i < 8; ++i) cube.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, i & 4 ? 1.5 : -1.5), w});
-    sets.push_back({"cube", cube});
-  }
-  {
-    std::vector<Ball> square;  // four on a square: coplanar and cocircular
-    for (int i = 0; i < 4; ++i) square.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, 0), w});
-    sets.push_back({"square", square});
-  }
-  {
-    std::vector<Ball> hexagon;  // six on a regular hexagon, two on its axis
-    for (int i = 0; i < 6; ++i) hexagon.push_back({Eigen::Vector3d(2.5 * std::cos(i * M_PI / 3), 2.5 * std::sin(i * M_PI / 3), 0), w});
-    hexagon.push_back({Eigen::Vector3d(0, 0, 1.8), w});
-    hexagon.push_back({Eigen::Vector3d(0, 0, -1.8), w});
-    sets.push_back({"hexagon with two on its axis", hexagon});
-  }
-  {
-    std::vector<Ball> octahedron;  // a regular octahedron of balls around a void
-    for (int k = 0; k < 3; ++k)
-      for (int sign = -1; sign <= 1; sign += 2) {
-        Eigen::Vector3d p = Eigen::Vector3d::Zero();
-        p[k] = 2.2 * sign;
-        octahedron.push_back({p, w});
-      }
-    sets.push_back({"octahedron", octahedron});
-  }
+  const auto sets = symmetric_ball_sets();
   for (const auto& [name, balls] : sets) {
     const std::vector<Ball> reference = jittered(balls);
     check_guarantees(balls, name, {}, 0.5, &reference);
   }
-}
-
-std::vector<Ball> centred_model(const std::string& path, int model) {
-  ReadOptions read;
-  read.model = model;
-  std::vector<Ball> balls = balls_from_molecule(read_molecule(path, read), 0.5);
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const Ball& b : balls) c += b.center;
-  c /= static_cast<double>(balls.size());
-  for (Ball& b : balls) b.center -= c;
-  return balls;
 }
 
 TEST_CASE("mesher guarantees on the exact midway sets of two morphs", "[mesher][degenerate][interpolation]") {
@@ -219,7 +180,7 @@ TEST_CASE("mesher guarantees on the exact midway sets of two morphs", "[mesher][
        {centred_model(shared_pdb("2k39_3models.pdb"), 1), centred_model(shared_pdb("2k39_3models.pdb"), 2)}}};
   for (const auto& [name, pair] : morphs) {
     INFO(name);
-    const std::vector<Ball> balls = interpolated_balls(pair.first, pair.second, live_pairs(pair.first, pair.second), 0.5);
+    const std::vector<Ball> balls = midway(pair.first, pair.second);
     const std::vector<Ball> reference = jittered(balls);
     // Every guarantee, zero-area triangles included, and CGAL's topology.
     const SkinMeshResult r = check_guarantees(balls, name, {}, 0.5, &reference);

@@ -151,49 +151,17 @@ TEST_CASE("the oracle is certified on the skin and far from the origin", "[skin]
   CHECK(worst_moved <= 1e-6);  // 1000 A coordinates keep ~12 digits of the local geometry
 }
 
-namespace {
-
-std::vector<Ball> centred_molecule(const std::string& path, int model) {
-  ReadOptions read;
-  read.model = model;
-  std::vector<Ball> balls = balls_from_molecule(read_molecule(path, read), 0.5);
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const Ball& b : balls) c += b.center;
-  c /= static_cast<double>(balls.size());
-  for (Ball& b : balls) b.center -= c;
-  return balls;
-}
-
-}  // namespace
-
 TEST_CASE("cospherical and interpolated ball sets: skin function and crossings equal the oracle",
           "[skin][oracle][degenerate][segment]") {
-  const double s = 0.5, w = 1.5 * 1.5 / 0.5;
-  std::vector<std::pair<std::string, std::vector<Ball>>> sets;
-  {
-    std::vector<Ball> cube, square, hexagon, octahedron;
-    for (int i = 0; i < 8; ++i) cube.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, i & 4 ? 1.5 : -1.5), w});
-    for (int i = 0; i < 4; ++i) square.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, 0), w});
-    for (int i = 0; i < 6; ++i) hexagon.push_back({Eigen::Vector3d(2.5 * std::cos(i * M_PI / 3), 2.5 * std::sin(i * M_PI / 3), 0), w});
-    hexagon.push_back({Eigen::Vector3d(0, 0, 1.8), w});
-    hexagon.push_back({Eigen::Vector3d(0, 0, -1.8), w});
-    for (int k = 0; k < 3; ++k)
-      for (int sign = -1; sign <= 1; sign += 2) {
-        Eigen::Vector3d p = Eigen::Vector3d::Zero();
-        p[k] = 2.2 * sign;
-        octahedron.push_back({p, w});
-      }
-    sets = {{"cube", cube}, {"square", square}, {"hexagon with two on its axis", hexagon}, {"octahedron", octahedron}};
-  }
+  const double s = 0.5;
+  auto sets = test::symmetric_ball_sets();
   // The exact B(1/2) of two morphs (MATH.md 4): groups of balls orthogonal to
   // one sphere everywhere, which CGAL splits into flat tetrahedra.
-  auto midway = [](const std::vector<Ball>& a, const std::vector<Ball>& b) {
-    return interpolated_balls(a, b, live_pairs(a, b), 0.5);
-  };
-  sets.push_back({"B(1/2) pept -> 3al1", midway(centred_molecule(test::data_file("pept.pdb"), 1),
-                                                centred_molecule(test::data_file("3al1.pdb"), 1))});
-  sets.push_back({"B(1/2) 2k39 model 1 -> 2", midway(centred_molecule(test::shared_pdb("2k39_3models.pdb"), 1),
-                                                     centred_molecule(test::shared_pdb("2k39_3models.pdb"), 2))});
+  sets.push_back({"B(1/2) pept -> 3al1", test::midway(test::centred_model(test::data_file("pept.pdb"), 1),
+                                                      test::centred_model(test::data_file("3al1.pdb"), 1))});
+  sets.push_back({"B(1/2) 2k39 model 1 -> 2",
+                  test::midway(test::centred_model(test::shared_pdb("2k39_3models.pdb"), 1),
+                               test::centred_model(test::shared_pdb("2k39_3models.pdb"), 2))});
   for (const auto& [name, balls] : sets) {
     INFO(name);
     const SkinComplex sc = build_skin_complex(balls, {s});

@@ -2,9 +2,12 @@
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/molecule.hpp"
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -55,6 +58,40 @@ inline std::vector<Eigen::Vector3d> sample_near_balls(const std::vector<Ball>& b
     points.push_back(b.center + u.normalized() * std::abs(r));
   }
   return points;
+}
+
+// Model `model` of a molecule file as balls (w = r^2/s, s = 1/2), centred.
+inline std::vector<Ball> centred_model(const std::string& path, int model) {
+  ReadOptions read;
+  read.model = model;
+  std::vector<Ball> balls = balls_from_molecule(read_molecule(path, read), 0.5);
+  centre_balls(balls);
+  return balls;
+}
+
+// The exact B(1/2) of two ball sets, live pairs only (MATH.md section 4).
+inline std::vector<Ball> midway(const std::vector<Ball>& a, const std::vector<Ball>& b) {
+  return interpolated_balls(a, b, live_pairs(a, b), 0.5);
+}
+
+// Equal balls (lone skin radius 1.5 A at s = 1/2) in cospherical and coplanar
+// arrangements: a cube's corners, a square, a regular hexagon with two on its
+// axis, a regular octahedron.
+inline std::vector<std::pair<std::string, std::vector<Ball>>> symmetric_ball_sets() {
+  const double w = 1.5 * 1.5 / 0.5;
+  std::vector<Ball> cube, square, hexagon, octahedron;
+  for (int i = 0; i < 8; ++i) cube.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, i & 4 ? 1.5 : -1.5), w});
+  for (int i = 0; i < 4; ++i) square.push_back({Eigen::Vector3d(i & 1 ? 1.5 : -1.5, i & 2 ? 1.5 : -1.5, 0), w});
+  for (int i = 0; i < 6; ++i) hexagon.push_back({Eigen::Vector3d(2.5 * std::cos(i * M_PI / 3), 2.5 * std::sin(i * M_PI / 3), 0), w});
+  hexagon.push_back({Eigen::Vector3d(0, 0, 1.8), w});
+  hexagon.push_back({Eigen::Vector3d(0, 0, -1.8), w});
+  for (int k = 0; k < 3; ++k)
+    for (int sign = -1; sign <= 1; sign += 2) {
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      p[k] = 2.2 * sign;
+      octahedron.push_back({p, w});
+    }
+  return {{"cube", cube}, {"square", square}, {"hexagon with two on its axis", hexagon}, {"octahedron", octahedron}};
 }
 
 }  // namespace skinmesh::test

@@ -107,6 +107,14 @@ std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vec
   return out;
 }
 
+void centre_balls(std::vector<Ball>& balls) {
+  if (balls.empty()) return;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Ball& b : balls) c += b.center;
+  c /= static_cast<double>(balls.size());
+  for (Ball& b : balls) b.center -= c;
+}
+
 std::vector<Ball> interpolated_balls(const std::vector<Ball>& source, const std::vector<Ball>& target,
                                      const std::vector<BallPair>& pairs, double t) {
   std::vector<Ball> out;

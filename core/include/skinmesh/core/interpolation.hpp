@@ -31,6 +31,10 @@ std::vector<BallPair> all_pairs(size_t m, size_t n);
 // the regular triangulation of B(1/2). Sorted.
 std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target);
 
+// Moves the balls so that the mean of their centres is the origin (morphs
+// between molecules in different frames are commonly taken centred).
+void centre_balls(std::vector<Ball>& balls);
+
 // The balls b_ij(t) of the given pairs, in their order.
 std::vector<Ball> interpolated_balls(const std::vector<Ball>& source, const std::vector<Ball>& target,
                                      const std::vector<BallPair>& pairs, double t);
