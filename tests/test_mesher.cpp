@@ -172,8 +172,8 @@ TEST_CASE("mesher guarantees on the exact midway sets of two morphs", "[mesher][
   // B(1/2) of pept -> 3al1 and of 2k39 model 1 -> 2, both centred, live
   // pairs, no jitter: groups of balls orthogonal to one sphere everywhere.
   // CGAL's mesher gets these wrong unless the centres are jittered by 1e-9 A
-  // (measured: 12,072 zero-area triangles and 56% too much area on the
-  // first); its mesh of the jittered set is the reference.
+  // (measured with bench/cgal_skin_mesh: 12,106 zero-area triangles and 56%
+  // too much area on the first); its mesh of the jittered set is the reference.
   const std::pair<std::string, std::pair<std::vector<Ball>, std::vector<Ball>>> morphs[] = {
       {"B(1/2) pept -> 3al1", {centred_model(data_file("pept.pdb"), 1), centred_model(data_file("3al1.pdb"), 1)}},
       {"B(1/2) 2k39 model 1 -> 2",
