@@ -28,7 +28,10 @@ std::vector<BallPair> all_pairs(size_t m, size_t n);
 // regular triangulation (its power diagram is the overlay of the two, MATH.md
 // section 4), about m + n of them. Found by a walk over the overlay from the
 // pairs holding the balls' centres, each candidate tested by insertion into
-// the regular triangulation of B(1/2). Sorted.
+// the regular triangulation of B(1/2). Sorted. A pair whose overlay cell has
+// no volume (atoms that stay put make the two diagrams share facets) may be
+// kept or dropped, as CGAL's symbolic perturbation decides; either way the
+// skin is the same.
 std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target);
 
 // Moves the balls so that the mean of their centres is the origin (morphs
