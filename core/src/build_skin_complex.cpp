@@ -136,12 +136,13 @@ void add_constraints_beyond_flat_cofaces(std::vector<MixedCell>& cells, const st
           for (int j = 0; j <= cells[static_cast<size_t>(t)].dim; ++j) {
             const int ball = cells[static_cast<size_t>(t)].balls[static_cast<size_t>(j)];
             if (!std::binary_search(cluster_balls.begin(), cluster_balls.end(), ball))
-              extra[static_cast<size_t>(x)].push_back({ball, t, true});
+              extra[static_cast<size_t>(x)].push_back({ball, t, true, false});
           }
       }
   }
   std::vector<SkinComplexCoface> merged;
   std::vector<int> offset(m + 1, 0);
+  for (SkinComplexCoface& c : cofaces) c.flat = cells[static_cast<size_t>(c.cell)].degenerate;
   for (size_t i = 0; i < m; ++i) {
     merged.insert(merged.end(), cofaces.begin() + coface_offset[i], cofaces.begin() + coface_offset[i + 1]);
     merged.insert(merged.end(), extra[i].begin(), extra[i].end());
@@ -234,7 +235,7 @@ SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions
     const MixedCell& c = cells[i];
     for (int drop = 0; drop < (c.dim > 0 ? c.dim + 1 : 0); ++drop) {
       const int face = sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)];
-      sc.cofaces_[static_cast<size_t>(fill[static_cast<size_t>(face)]++)] = {c.balls[drop], static_cast<int>(i), false};
+      sc.cofaces_[static_cast<size_t>(fill[static_cast<size_t>(face)]++)] = {c.balls[drop], static_cast<int>(i), false, false};
     }
   }
 

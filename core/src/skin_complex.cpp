@@ -77,7 +77,7 @@ static Violation worst_violation(const SkinComplex& sc, int c, const Eigen::Vect
   for (auto it = sc.cofaces_begin(c); it != sc.cofaces_end(c); ++it) {
     // A flat coface's ball is co-orthogonal with X's along aff(nu_X): its
     // bound is void (rounding noise); the cells beyond it bound nu_X instead.
-    if (sc.cell(it->cell).degenerate) continue;
+    if (it->flat) continue;
     const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
     const double gap = (bk.center - b0.center).norm();
     const double slack = (bk.power(v) - pi0) / (2 * std::max(gap, 1e-300));  // signed distance to the bisector
@@ -310,7 +310,7 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
     const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
     const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;
     for (auto it = cofaces_begin(c); it != cofaces_end(c); ++it) {
-      if (cells_[static_cast<size_t>(it->cell)].degenerate) continue;  // void bound (see worst_violation)
+      if (it->flat) continue;  // void bound (see worst_violation)
       const Ball& bk = balls_[static_cast<size_t>(it->ball)];
       // pi_k(v) - pi_0(v) = -2 <v, z_k - z_0> + |z_k|^2 - w_k - |z_0|^2 + w_0
       const Eigen::Vector3d dz = bk.center - b0.center;

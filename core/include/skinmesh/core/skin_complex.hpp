@@ -85,6 +85,7 @@ class SkinComplex {
     int ball;
     int cell;
     bool beyond = false;  // a cell past a flat coface, not adjacent: walks locate from it
+    bool flat = false;    // the coface is flat: its ball bounds nothing (kept here to spare a cell lookup)
   };
   const int* faces_begin(int c) const { return faces_.data() + face_offset_[c]; }
   const int* faces_end(int c) const { return faces_.data() + face_offset_[c + 1]; }
