@@ -78,6 +78,23 @@ void check_interior(const std::string& path) {
   CHECK(boundary == expected);
 }
 
+// Runs improve_tet_mesh with the default bounds on a mesh with a tetrahedron
+// below 5 degrees, and checks what every improvement must give: nothing left
+// outside the bounds, nothing inverted, the same volume.
+TetImprovement improve_and_check(TetMesh& mesh) {
+  const TetQuality before = grade_tet_mesh(mesh);
+  REQUIRE(before.inverted == 0);
+  REQUIRE(before.min_dihedral < 5.0);
+  const TetImprovement r = improve_tet_mesh(mesh, 2.0, 5.0);
+  const TetQuality after = grade_tet_mesh(mesh);
+  CHECK(r.bad_after == 0);
+  CHECK(after.inverted == 0);
+  CHECK(after.min_dihedral >= 5.0);
+  CHECK(after.max_radius_edge <= 2.0);
+  CHECK(std::abs(after.volume - before.volume) <= 1e-12);
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("interior volume meshes: bounds, exact volume, the surface as boundary", "[volume]") {
@@ -107,19 +124,10 @@ TEST_CASE("moving TetGen's points brings a flat tetrahedron within bounds", "[vo
     mesh.tets.push_back(t);
     mesh.tet_region.push_back(kRegionInterior);
   }
-  const TetQuality before = grade_tet_mesh(mesh);
-  REQUIRE(before.inverted == 0);
-  REQUIRE(before.min_dihedral < 5.0);
   const TetMesh original = mesh;
-  const TetImprovement r = improve_tet_mesh(mesh, 2.0, 5.0);
-  const TetQuality after = grade_tet_mesh(mesh);
+  const TetImprovement r = improve_and_check(mesh);
   CHECK(r.bad_before >= 1);
-  CHECK(r.bad_after == 0);
   CHECK(r.moved == 1);
-  CHECK(after.inverted == 0);
-  CHECK(after.min_dihedral >= 5.0);
-  CHECK(after.max_radius_edge <= 2.0);
-  CHECK(std::abs(after.volume - before.volume) <= 1e-12);
   for (int v = 0; v < 4; ++v) CHECK(mesh.points[static_cast<size_t>(v)] == original.points[static_cast<size_t>(v)]);
   CHECK(mesh.tets == original.tets);
   CHECK(mesh.faces == original.faces);
@@ -140,20 +148,11 @@ TEST_CASE("removing an edge undoes a flat tetrahedron of four surface points", "
     if ((q - p).dot((r - p).cross(s - p)) < 0) std::swap(t[2], t[3]);
   }
   mesh.tet_region.assign(3, kRegionInterior);
-  const TetQuality before = grade_tet_mesh(mesh);
-  REQUIRE(before.inverted == 0);
-  REQUIRE(before.min_dihedral < 5.0);
   const TetMesh original = mesh;
-  const TetImprovement r = improve_tet_mesh(mesh, 2.0, 5.0);
-  const TetQuality after = grade_tet_mesh(mesh);
+  const TetImprovement r = improve_and_check(mesh);
   CHECK(r.flips == 1);
   CHECK(r.moved == 0);
-  CHECK(r.bad_after == 0);
   CHECK(mesh.tets.size() == 2);
-  CHECK(after.inverted == 0);
-  CHECK(after.min_dihedral >= 5.0);
-  CHECK(after.max_radius_edge <= 2.0);
-  CHECK(std::abs(after.volume - before.volume) <= 1e-12);
   CHECK(mesh.points == original.points);
   CHECK(mesh.faces == original.faces);
   // Each marked face is still a face of exactly one tetrahedron.

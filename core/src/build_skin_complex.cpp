@@ -2,9 +2,7 @@
 // predicates). CGAL stays in this file: the complex it produces is plain data.
 #include "skinmesh/core/skin_complex.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Regular_triangulation_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include "regular_triangulation.hpp"
 
 #include <Eigen/Dense>
 
@@ -19,12 +17,8 @@ namespace {
 
 using SkinComplexCoface = SkinComplex::Coface;
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb0 = CGAL::Regular_triangulation_vertex_base_3<K>;
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, Vb0>;
-using Cb = CGAL::Regular_triangulation_cell_base_3<K>;
-using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
-using Regular = CGAL::Regular_triangulation_3<K, Tds>;
+using K = detail::RtKernel;
+using Regular = detail::RegularTriangulation<int>;
 
 using Key = std::array<int, 4>;  // ascending ball indices, padded with -1
 struct KeyHash {

@@ -1,9 +1,7 @@
 // The interpolated set of a morph and its live pairs (see interpolation.hpp).
 #include "skinmesh/core/interpolation.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Regular_triangulation_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include "regular_triangulation.hpp"
 
 #include <algorithm>
 #include <deque>
@@ -14,12 +12,8 @@
 namespace skinmesh {
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb0 = CGAL::Regular_triangulation_vertex_base_3<K>;
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<long, K, Vb0>;
-using Cb = CGAL::Regular_triangulation_cell_base_3<K>;
-using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
-using Regular = CGAL::Regular_triangulation_3<K, Tds>;
+using K = detail::RtKernel;
+using Regular = detail::RegularTriangulation<long>;
 using Weighted = K::Weighted_point_3;
 
 Weighted weighted(const Ball& b) { return Weighted(K::Point_3(b.center[0], b.center[1], b.center[2]), b.weight); }
