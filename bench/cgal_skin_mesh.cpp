@@ -1,8 +1,11 @@
-// CGAL's skin mesh (make_skin_surface_mesh_3, Kruithof-Vegter) of a molecule,
+// CGAL's skin mesh (Kruithof-Vegter, as make_skin_surface_mesh_3) of a molecule,
 // with the same balls as skinmesh (w = r^2/s, s = 1/2), written as OFF, so
 // that `skinmesh quality` can grade it next to a skinmesh mesh.
 //
-//   cgal_skin_mesh MOLECULE OUT.off [--subdivisions N]
+//   cgal_skin_mesh MOLECULE OUT.off [--subdivisions N] [--jitter A]
+//
+// --jitter moves every centre by up to A Angstrom per coordinate (fixed seed),
+// which CGAL needs on degenerate sets such as the interpolated sets of a morph.
 #include "cgal_reference.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/meshing/mesh_write.hpp"
@@ -15,17 +18,31 @@
 using namespace skinmesh;
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: cgal_skin_mesh MOLECULE OUT.off [--subdivisions N]\n");
+  const char* usage = "usage: cgal_skin_mesh MOLECULE OUT.off [--subdivisions N] [--jitter A]\n";
+  if (argc < 3 || argc % 2 == 0) {
+    std::fprintf(stderr, "%s", usage);
     return 2;
   }
   const std::string input = argv[1], output = argv[2];
   int subdivisions = 0;
-  if (argc >= 5 && std::string(argv[3]) == "--subdivisions") subdivisions = std::atoi(argv[4]);
+  double jitter = 0;
+  for (int i = 3; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i];
+    char* end = nullptr;
+    const double value = std::strtod(argv[i + 1], &end);
+    if (*end != '\0' || !(value >= 0) || (flag != "--subdivisions" && flag != "--jitter")) {
+      std::fprintf(stderr, "cgal_skin_mesh: bad option %s %s\n%s", argv[i], argv[i + 1], usage);
+      return 2;
+    }
+    if (flag == "--subdivisions") subdivisions = static_cast<int>(value);
+    else jitter = value;
+  }
   const double s = 0.5;
   SurfaceMesh mesh;
   try {
-    mesh = test::cgal_skin_mesh(balls_from_molecule(read_molecule(input), s), s, subdivisions);
+    std::vector<Ball> balls = balls_from_molecule(read_molecule(input), s);
+    if (jitter > 0) balls = test::jittered(balls, jitter);
+    mesh = test::cgal_skin_mesh(balls, s, subdivisions);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cgal_skin_mesh: %s\n", e.what());
     return 2;

@@ -16,7 +16,6 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <random>
 
 using namespace skinmesh;
 using namespace skinmesh::test;
@@ -152,14 +151,6 @@ TEST_CASE("mesher guarantees on adversarial ball sets", "[mesher]") {
   }
 }
 
-// The balls moved by up to 1e-9 A in each coordinate (deterministically).
-std::vector<Ball> jittered(std::vector<Ball> balls, unsigned seed = 1) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1e-9, 1e-9);
-  for (Ball& b : balls) b.center += Eigen::Vector3d(u(rng), u(rng), u(rng));
-  return balls;
-}
-
 TEST_CASE("mesher guarantees on cospherical and coplanar ball sets", "[mesher][degenerate]") {
   const auto sets = symmetric_ball_sets();
   for (const auto& [name, balls] : sets) {
@@ -183,16 +174,28 @@ TEST_CASE("mesher guarantees on the exact midway sets of two morphs", "[mesher][
     const std::vector<Ball> balls = midway(pair.first, pair.second);
     const std::vector<Ball> reference = jittered(balls);
     // Every guarantee, zero-area triangles included, and CGAL's topology.
-    const SkinMeshResult r = check_guarantees(balls, name, {}, 0.5, &reference);
-    const MeshQuality ours = grade_mesh(r.mesh, GradeOptions{false});
-    const MeshQuality theirs = grade_mesh(cgal_skin_mesh(reference, 0.5), GradeOptions{false});
+    check_guarantees(balls, name, {}, 0.5, &reference);
+    // Area and volume against CGAL's mesh refined twice (each step splits
+    // every triangle in four and projects onto CGAL's skin). Both meshes are
+    // inscribed, so both lie a little inside the skin; the comparison needs
+    // each of them close to it. Measured (2k39, then pept -> 3al1, A^2 and A^3):
+    //   CGAL, 0 / 1 / 2 steps: area 923.9 / 932.3 / 934.8, volume 983.2 / 1002.0 / 1007.0;
+    //                          area 1057.2 / 1063.0 / 1064.7, volume 1589.1 / 1597.5 / 1599.8;
+    //   ours, tolerance 0.1 (default) / 0.02 / 0.005: area 924.9 / 931.6 / 933.0,
+    //                          volume 997.7 / 1006.6 / 1008.2;
+    //                          area 1052.3 / 1061.7 / 1063.6, volume 1593.7 / 1599.3 / 1600.2;
+    //   the skin function's Monte Carlo volume (4e6 samples): 1010.9 +- 1.3, 1599.7 +- 1.5.
+    // So at the default tolerance our mesh (like CGAL's unrefined one) lies
+    // about 1% inside the skin; at 0.02 A both agree within 0.35%.
+    MeshingOptions fine;
+    fine.tolerance = 0.02;
+    const MeshQuality ours = grade_mesh(mesh_skin(build_skin_complex(balls, {0.5}), fine).mesh, GradeOptions{false});
+    const MeshQuality theirs = grade_mesh(cgal_skin_mesh(reference, 0.5, 2), GradeOptions{false});
     INFO("area " << ours.area << " vs " << theirs.area << ", volume " << ours.volume << " vs " << theirs.volume);
     CHECK(std::abs(ours.area - theirs.area) <= 0.005 * theirs.area);
-    // Volume: measured 0.29% and 1.44% apart. CGAL's coarse mesh lies below
-    // the skin's volume (a Monte Carlo estimate by the skin function, 4e6
-    // samples: 1599.7 +- 1.5 and 1010.9 +- 1.3 A^3, against CGAL's 1589.1 and
-    // 983.2 and our 1593.7 and 997.7), so the bound is the measured one.
-    CHECK(std::abs(ours.volume - theirs.volume) <= 0.015 * theirs.volume);
+    CHECK(std::abs(ours.volume - theirs.volume) <= 0.005 * theirs.volume);
+    CHECK(ours.components == theirs.components);
+    CHECK(ours.euler == theirs.euler);
   }
 }
 
