@@ -5,8 +5,10 @@
 //   - skinmesh with its edge-contraction clean-up (--contract-below 0.5);
 //   - skinmesh with edges capped at L (--edge-length L; the curvature bound
 //     still applies where it is smaller);
-//   - CGAL make_skin_surface_mesh_3 (Kruithof-Vegter, certified topology),
-//     0 and 1 subdivision steps;
+//   - CGAL's skin mesher (Kruithof-Vegter, certified topology; what
+//     make_skin_surface_mesh_3 builds, with faces that keep their mixed-complex
+//     cell so that each subdivision projects from there), 0 and 1 subdivision
+//     steps;
 //   - CGAL Surface_mesher (restricted Delaunay refinement) on the same skin as
 //     an implicit surface, angle bound 30 degrees, Delaunay-ball radius bound
 //     L/sqrt(3) and distance bound 0.1 A: the criteria of the capped skinmesh
