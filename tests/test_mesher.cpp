@@ -184,7 +184,7 @@ TEST_CASE("mesher guarantees on the exact midway sets of two morphs", "[mesher][
     //   ours, tolerance 0.1 (default) / 0.02 / 0.005: area 924.9 / 931.6 / 933.0,
     //                          volume 997.7 / 1006.6 / 1008.2;
     //                          area 1052.3 / 1061.7 / 1063.6, volume 1593.7 / 1599.3 / 1600.2;
-    //   the skin function's Monte Carlo volume (4e6 samples): 1010.9 +- 1.3, 1599.7 +- 1.5.
+    //   a Monte Carlo volume by skinmesh's skin function (4e6 samples): 1010.9 +- 1.3, 1599.7 +- 1.5.
     // So at the default tolerance our mesh (like CGAL's unrefined one) lies
     // about 1% inside the skin; at 0.02 A both agree within 0.35%.
     MeshingOptions fine;
