@@ -2,7 +2,7 @@
 // with the same balls as skinmesh (w = r^2/s, s = 1/2), written as OFF, so
 // that `skinmesh quality` can grade it next to a skinmesh mesh.
 //
-//   cgal_skin_mesh MOLECULE OUT.off [--subdivisions N] [--jitter A]
+//   cgal_skin_mesh MOLECULE OUT.off [--subdivisions N (0-8)] [--jitter A]
 //
 // --jitter moves every centre by up to A Angstrom per coordinate (fixed seed),
 // which CGAL needs on degenerate sets such as the interpolated sets of a morph.
@@ -30,7 +30,8 @@ int main(int argc, char** argv) {
     const std::string flag = argv[i];
     char* end = nullptr;
     const double value = std::strtod(argv[i + 1], &end);
-    if (*end != '\0' || !(value >= 0) || (flag != "--subdivisions" && flag != "--jitter")) {
+    const bool known = flag == "--jitter" || (flag == "--subdivisions" && value <= 8 && value == static_cast<int>(value));
+    if (*end != '\0' || !(value >= 0) || !known) {
       std::fprintf(stderr, "cgal_skin_mesh: bad option %s %s\n%s", argv[i], argv[i + 1], usage);
       return 2;
     }

@@ -21,7 +21,7 @@ SurfaceMesh cgal_skin_mesh(const std::vector<Ball>& balls, double shrink, int su
   // Faces that remember their cell of CGAL's triangulated mixed complex: each
   // subdivision step then projects a new vertex from that cell instead of
   // walking to it from the infinite cell, which on the 1e-9 A-jittered midway
-  // set of 2k39 took longer than 25 minutes for one step (2 s this way).
+  // set of 2k39 took longer than 25 minutes for one step (0.8 s this way).
   using Polyhedron = CGAL::Polyhedron_3<K, CGAL::Skin_surface_polyhedral_items_3<Skin>>;
   std::vector<K::Weighted_point_3> points;
   for (const Ball& b : balls) points.emplace_back(K::Point_3(b.center[0], b.center[1], b.center[2]), b.weight);
