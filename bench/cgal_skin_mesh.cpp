@@ -18,7 +18,7 @@
 using namespace skinmesh;
 
 int main(int argc, char** argv) {
-  const char* usage = "usage: cgal_skin_mesh MOLECULE OUT.off [--subdivisions N] [--jitter A]\n";
+  const char* usage = "usage: cgal_skin_mesh MOLECULE OUT.off [--subdivisions N (0-8)] [--jitter A]\n";
   if (argc < 3 || argc % 2 == 0) {
     std::fprintf(stderr, "%s", usage);
     return 2;
