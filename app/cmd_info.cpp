@@ -1,7 +1,9 @@
 // skinmesh info: what was read, the radii used, and the skin complex built on it.
 #include "commands.hpp"
+#include "exit_codes.hpp"
 #include "molecule_options.hpp"
 
+#include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/core/radii.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 
@@ -58,9 +60,9 @@ json describe(const Molecule& m, const MoleculeOptions& o) {
   for (const Atom& a : m.atoms) lo = lo.cwiseMin(a.position), hi = hi.cwiseMax(a.position);
   j["bounding_box"] = {{"min", {lo.x(), lo.y(), lo.z()}}, {"max", {hi.x(), hi.y(), hi.z()}}};
 
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const SkinComplex sc = build_skin_complex(balls_from_molecule(m, o.shrink, o.convention()), {o.shrink});
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = seconds_since(t0);
   const auto counts = sc.cell_counts();
   j["shrink"] = o.shrink;
   j["weights"] = m.format == MoleculeFormat::Wpts ? "as given (weighted points)" : convention_name(o.convention());
@@ -154,7 +156,7 @@ void add_info_command(CLI::App& app, const GlobalOptions& global, int& exit_code
     } else {
       for (const json& j : all) print_text(j, std::cout);
     }
-    exit_code = 0;
+    exit_code = code(ExitCode::ok);
   });
 }
 

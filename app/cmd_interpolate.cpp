@@ -1,11 +1,13 @@
 // skinmesh interpolate: the ball set B(t) = {(1-t) a_i + t b_j} between a
-// source and a target molecule (MATH.md sections 1 and 4), live pairs only or
+// source and a target molecule (docs/math.md sections 1 and 4), live pairs only or
 // all m*n, written as weighted points (.wpts) that every command reads like a
 // molecule, so an intermediate skin can be meshed and inspected as a static one.
 #include "commands.hpp"
+#include "exit_codes.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 
+#include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/file_names.hpp"
 #include "skinmesh/core/interpolation.hpp"
@@ -53,9 +55,9 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
   add_molecule_settings(*cmd, o->molecule);
   cmd->callback([o, &global, &exit_code]() {
     if (!has_extension(lowercase(o->output), ".wpts"))
-      throw std::invalid_argument(o->output + ": interpolated weights can be negative, which XYZR cannot hold; "
+      contract_error(o->output + ": interpolated weights can be negative, which XYZR cannot hold; "
                                   "write weighted points, OUT.wpts");
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     const std::vector<Ball> a = read_balls(o->source, o->molecule.read, o->source_model, o->molecule, o->centre);
     const std::vector<Ball> b = read_balls(o->target, o->molecule.read, o->target_model, o->molecule, o->centre);
     const std::vector<BallPair> pairs = o->all ? all_pairs(a.size(), b.size()) : live_pairs(a, b);
@@ -69,7 +71,7 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
             << "; shrink " << o->molecule.shrink << ", weights "
             << convention_name(o->molecule.convention());
     write_file_atomically(o->output, [&](std::ostream& out) { write_wpts(out, balls, comment.str()); });
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double seconds = seconds_since(t0);
     nlohmann::json report{{"source", o->source},  {"target", o->target},         {"t", o->t},
                           {"source_balls", a.size()}, {"target_balls", b.size()}, {"all_pairs", a.size() * b.size()},
                           {"balls", balls.size()}, {"negative_weights", negative}, {"live_pairs_only", !o->all},
@@ -79,7 +81,7 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
       std::cout << o->output << ": " << balls.size() << " weighted points at t = " << o->t << " ("
                 << (o->all ? "all" : "live") << " pairs of " << a.size() << " x " << b.size() << " = "
                 << a.size() * b.size() << "; " << negative << " negative weights), " << seconds << " s\n";
-    exit_code = 0;
+    exit_code = code(ExitCode::ok);
   });
 }
 

@@ -1,14 +1,17 @@
 // skinmesh quality: grade any triangle mesh; with --molecule, also how far each
-// vertex is from that molecule's skin (by the oracle of MATH.md section 2).
+// vertex is from that molecule's skin (by the oracle of docs/math.md section 2).
 #include "commands.hpp"
+#include "exit_codes.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
 
 #include "skinmesh/core/error.hpp"
-#include "skinmesh/meshing/mesh_io.hpp"
-#include "skinmesh/meshing/mesh_quality.hpp"
-#include "skinmesh/meshing/volume_mesh.hpp"
+#include "skinmesh/mesh_io/mesh_read.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+#include "skinmesh/quality/on_surface_error.hpp"
+#include "skinmesh/quality/tet_quality.hpp"
+#include "skinmesh/volume/volume_mesh.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -64,27 +67,30 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
                   << report["boundary_faces_not_marked"].get<long>() << " not among the marked faces, "
                   << report["marked_faces_not_on_boundary"].get<long>() << " marked faces not on a boundary\n";
       }
-      exit_code = 0;
+      exit_code = code(ExitCode::ok);
       return;
     }
     SurfaceMesh mesh;
     if (gmsh) {
-      if (gmsh->faces.empty()) throw InputError(o->mesh, 0, "mesh has no triangles");
+      if (gmsh->faces.empty()) input_error(o->mesh, 0, "mesh has no triangles");
       mesh.vertices = std::move(gmsh->points);
       mesh.triangles = std::move(gmsh->faces);
     } else {
       mesh = read_surface_mesh(o->mesh);
     }
     GradeOptions grade;
-    grade.check_self_intersections = !o->no_self_intersections;
+    grade.self_intersections = o->no_self_intersections ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
     const MeshQuality q = grade_mesh(mesh, grade);
     json report = to_json(q);
     report["file"] = o->mesh;
-    if (o->tetgen) report["tetgen_self_intersecting_pairs"] = tetgen_self_intersections(mesh);
+    if (o->tetgen) {
+      const long pairs = tetgen_self_intersections(mesh);
+      report["tetgen_self_intersecting_pairs"] = pairs >= 0 ? json(pairs) : json(nullptr);
+    }
     if (!o->molecule.path.empty()) {
       const Molecule m = read_molecule(o->molecule.path, o->molecule.read);
       const auto balls = balls_from_molecule(m, o->molecule.shrink, o->molecule.convention());
-      json error = on_surface_error_json(mesh.vertices, balls, o->molecule.shrink);
+      json error = to_json(on_surface_error(mesh.vertices, balls, o->molecule.shrink));
       error["molecule"] = o->molecule.path;
       error["shrink"] = o->molecule.shrink;
       error["weights"] = convention_name(o->molecule.convention());
@@ -96,13 +102,16 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
     } else {
       print_quality_summary(std::cout, o->mesh, q);
       if (report.contains("tetgen_self_intersecting_pairs"))
-        std::cout << "  TetGen -d:   " << report["tetgen_self_intersecting_pairs"].get<long>()
-                  << " intersecting pairs\n";
+        std::cout << "  TetGen -d:   "
+                  << (report["tetgen_self_intersecting_pairs"].is_null()
+                          ? std::string("could not be run")
+                          : std::to_string(report["tetgen_self_intersecting_pairs"].get<long>()) + " intersecting pairs")
+                  << "\n";
       if (report.contains("on_surface_error"))
         std::cout << "  on-surface error: max " << report["on_surface_error"]["max"].get<double>() << " A, mean "
                   << report["on_surface_error"]["mean"].get<double>() << " A (oracle, " << o->molecule.path << ")\n";
     }
-    exit_code = 0;
+    exit_code = code(ExitCode::ok);
   });
 }
 

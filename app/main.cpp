@@ -1,5 +1,6 @@
 // skinmesh: molecular skin surfaces, quality meshes and morphs.
 #include "commands.hpp"
+#include "exit_codes.hpp"
 
 #include "skinmesh/core/error.hpp"
 
@@ -12,7 +13,7 @@ int main(int argc, char** argv) {
   skinmesh::app::GlobalOptions global;
   app.add_flag("--json", global.json, "machine-readable JSON on stdout");
   app.add_flag("--quiet,-q", global.quiet, "no progress or warnings on the terminal");
-  int exit_code = 0;
+  int exit_code = code(skinmesh::app::ExitCode::ok);
   skinmesh::app::add_info_command(app, global, exit_code);
   skinmesh::app::add_mesh_command(app, global, exit_code);
   skinmesh::app::add_quality_command(app, global, exit_code);
@@ -24,10 +25,13 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const skinmesh::InputError& e) {
     std::cerr << "skinmesh: error: " << e.what() << "\n";
-    return 2;
+    return code(skinmesh::app::ExitCode::bad_input);
+  } catch (const skinmesh::ContractError& e) {
+    std::cerr << "skinmesh: error: " << e.what() << "\n";
+    return code(skinmesh::app::ExitCode::bad_input);
   } catch (const std::exception& e) {
     std::cerr << "skinmesh: error: " << e.what() << "\n";
-    return 1;
+    return code(skinmesh::app::ExitCode::failure);
   }
   return exit_code;
 }

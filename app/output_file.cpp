@@ -1,29 +1,42 @@
 #include "output_file.hpp"
 
+#include "skinmesh/core/error.hpp"
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <stdexcept>
 #include <unistd.h>
 
 namespace skinmesh::app {
 
-void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+OutputSet::~OutputSet() {
+  for (const auto& [temporary, target] : staged_) std::remove(temporary.c_str());
+}
+
+void OutputSet::add(const std::string& path, const std::function<void(std::ostream&)>& write) {
   const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
-  try {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path + ": cannot write (" + std::strerror(errno) + ")");
-    write(out);
-    out.flush();
-    if (!out) throw std::runtime_error(path + ": write failed");
-    out.close();
-    if (std::rename(temporary.c_str(), path.c_str()) != 0)
-      throw std::runtime_error(path + ": cannot rename into place (" + std::strerror(errno) + ")");
-  } catch (...) {
-    std::remove(temporary.c_str());
-    throw;
+  staged_.emplace_back(temporary, path);  // removed by the destructor from here on
+  std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+  if (!out) output_error(path, std::string("cannot write (") + std::strerror(errno) + ")");
+  write(out);
+  out.flush();
+  if (!out) output_error(path, "write failed");
+}
+
+void OutputSet::commit() {
+  while (!staged_.empty()) {
+    const auto [temporary, target] = staged_.front();
+    if (std::rename(temporary.c_str(), target.c_str()) != 0)
+      output_error(target, std::string("cannot rename into place (") + std::strerror(errno) + ")");
+    staged_.erase(staged_.begin());
   }
+}
+
+void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  OutputSet set;
+  set.add(path, write);
+  set.commit();
 }
 
 }  // namespace skinmesh::app

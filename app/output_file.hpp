@@ -1,15 +1,35 @@
-// Outputs are written to a temporary file beside the target and renamed into
-// place, so a failure never leaves a partial file behind.
+// All outputs of one command are written together or not at all: each file
+// goes to a temporary beside its target, and only when every one of them has
+// been written are they renamed into place. A failure (or a command that
+// ends before commit()) leaves no file behind.
 #pragma once
 
 #include <functional>
 #include <ostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace skinmesh::app {
 
-// Calls write(stream) on PATH.tmp-XXXX, then renames it to PATH. Throws
-// std::runtime_error (and removes the temporary) when anything fails.
+class OutputSet {
+ public:
+  OutputSet() = default;
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+  ~OutputSet();  // removes the temporaries not committed
+
+  // Writes PATH.tmp-PID now by calling write(stream). Throws OutputError.
+  void add(const std::string& path, const std::function<void(std::ostream&)>& write);
+  // Renames every temporary into place. Throws OutputError when one cannot
+  // be, after removing the temporaries left.
+  void commit();
+
+ private:
+  std::vector<std::pair<std::string, std::string>> staged_;  // (temporary, target)
+};
+
+// One output on its own: an OutputSet of one file, committed at once.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 }  // namespace skinmesh::app

@@ -73,10 +73,16 @@ void write_svg(std::ostream& out, const MeshQuality& q, const std::string& title
 }
 
 
-nlohmann::json on_surface_error_json(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
-                                     double shrink) {
-  const SurfaceError e = on_surface_error(vertices, balls, shrink);
+nlohmann::json to_json(const SurfaceError& e) {
   return {{"max", e.max}, {"mean", e.mean}, {"uncertified", e.uncertified}};
+}
+
+nlohmann::json guarantees_json(const GuaranteeReport& g) {
+  using json = nlohmann::json;
+  return {{"min_angle_at_least_bound", g.angle},
+          {"vertices_on_skin_within_1e-9", g.on_skin},
+          {"closed_oriented_manifold", g.closed_oriented_manifold},
+          {"no_self_intersections", g.no_self_intersections ? json(*g.no_self_intersections) : json(nullptr)}};
 }
 
 void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q) {

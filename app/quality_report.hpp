@@ -3,9 +3,11 @@
 // histogram of smallest angles.
 #pragma once
 
-#include "skinmesh/core/balls.hpp"
-#include "skinmesh/meshing/mesh_quality.hpp"
-#include "skinmesh/meshing/volume_mesh.hpp"
+#include "skinmesh/core/tet_mesh.hpp"
+#include "skinmesh/quality/guarantees.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+#include "skinmesh/quality/on_surface_error.hpp"
+#include "skinmesh/quality/tet_quality.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -17,9 +19,10 @@ namespace skinmesh::app {
 
 nlohmann::json to_json(const MeshQuality& q);
 
-// skinmesh::on_surface_error as JSON: {"max", "mean", "uncertified"}.
-nlohmann::json on_surface_error_json(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
-                                     double shrink);
+// {"max", "mean", "uncertified"}.
+nlohmann::json to_json(const SurfaceError& e);
+// Each guarantee true or false (no_self_intersections null when not checked).
+nlohmann::json guarantees_json(const GuaranteeReport& g);
 
 void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q);
 

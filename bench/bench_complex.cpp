@@ -3,7 +3,7 @@
 // complex) on the same balls. Each measurement runs in a forked child, so the
 // peak memory reported is that task's own.
 //
-//   bench_complex [--repeat N] [FILE...]     (default: 1hpv and 3mht from ../shared)
+//   bench_complex [--repeat N] [FILE...]     (default: data/1hpv.pdb and data/3mht.pdb)
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
     else files.push_back(a);
   }
   if (files.empty())
-    files = {std::string(SKINMESH_SHARED_PDB_DIR) + "/1hpv.pdb", std::string(SKINMESH_SHARED_PDB_DIR) + "/3mht.pdb"};
+    files = {std::string(SKINMESH_DATA_DIR) + "/1hpv.pdb", std::string(SKINMESH_DATA_DIR) + "/3mht.pdb"};
 
   const double s = 0.5;
   struct Row {

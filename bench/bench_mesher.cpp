@@ -15,17 +15,18 @@
 //     run, whose size rule is "radius > L/sqrt(3)" (plus its curvature bound).
 // Each run is a forked child (own peak memory, a time limit). After timing,
 // the child grades its mesh with the project's grader and measures every
-// vertex with the oracle of MATH.md section 2. Prints JSON lines, then a
+// vertex with the oracle of docs/math.md section 2. Prints JSON lines, then a
 // markdown table, then the ratios.
 //
 //   bench_mesher [--edge-length L] [--timeout S] [--skip-surface-mesher] [--only TEXT] [FILE...]
 //   (--only: run the methods whose name contains TEXT)
-//   (default files: data/pept.pdb, data/1ubi.pdb, ../shared/data/pdb/1hpv.pdb, 3mht.pdb)
+//   (default files: data/pept.pdb, data/1ubi.pdb, data/1hpv.pdb, data/3mht.pdb)
 #include "cgal_reference.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
-#include "skinmesh/meshing/mesh_quality.hpp"
-#include "skinmesh/meshing/skin_mesher.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+#include "skinmesh/quality/on_surface_error.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
 
 #include <CGAL/Complex_2_in_triangulation_3.h>
 #include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
@@ -185,7 +186,9 @@ SurfaceMesh ours(const std::vector<Ball>& balls, double edge_length, int threads
   options.edge_length = edge_length;
   options.threads = threads;
   options.contract_below = contract_below;
-  return mesh_skin(complex, options).mesh;
+  SkinMeshResult result = mesh_skin(complex, options);
+  if (result.status != MeshingStatus::ok) throw std::runtime_error(result.message);
+  return std::move(result.mesh);
 }
 
 struct Row {
@@ -234,7 +237,7 @@ int main(int argc, char** argv) {
   }
   if (files.empty())
     files = {std::string(SKINMESH_DATA_DIR) + "/pept.pdb", std::string(SKINMESH_DATA_DIR) + "/1ubi.pdb",
-             std::string(SKINMESH_SHARED_PDB_DIR) + "/1hpv.pdb", std::string(SKINMESH_SHARED_PDB_DIR) + "/3mht.pdb"};
+             std::string(SKINMESH_DATA_DIR) + "/1hpv.pdb", std::string(SKINMESH_DATA_DIR) + "/3mht.pdb"};
 
   char uniform[64], sm[96];
   std::snprintf(uniform, sizeof uniform, "skinmesh edges <= %g A", edge_length);

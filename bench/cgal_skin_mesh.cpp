@@ -8,7 +8,7 @@
 // which CGAL needs on degenerate sets such as the interpolated sets of a morph.
 #include "cgal_reference.hpp"
 #include "skinmesh/core/molecule.hpp"
-#include "skinmesh/meshing/mesh_write.hpp"
+#include "skinmesh/mesh_io/mesh_write.hpp"
 
 #include <cstdio>
 #include <cstdlib>

@@ -4,6 +4,7 @@
 #include "skinmesh/core/balls.hpp"
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
 
 #include <Eigen/Core>
 
@@ -18,7 +19,6 @@
 namespace skinmesh::test {
 
 inline std::string data_file(const std::string& name) { return std::string(SKINMESH_DATA_DIR) + "/" + name; }
-inline std::string shared_pdb(const std::string& name) { return std::string(SKINMESH_SHARED_PDB_DIR) + "/" + name; }
 
 // A file in a fresh temporary directory, removed with the object.
 class TempFile {
@@ -69,7 +69,7 @@ inline std::vector<Ball> centred_model(const std::string& path, int model) {
   return balls;
 }
 
-// The exact B(1/2) of two ball sets, live pairs only (MATH.md section 4).
+// The exact B(1/2) of two ball sets, live pairs only (docs/math.md section 4).
 inline std::vector<Ball> midway(const std::vector<Ball>& a, const std::vector<Ball>& b) {
   return interpolated_balls(a, b, live_pairs(a, b), 0.5);
 }
@@ -92,6 +92,21 @@ inline std::vector<std::pair<std::string, std::vector<Ball>>> symmetric_ball_set
       octahedron.push_back({p, w});
     }
   return {{"cube", cube}, {"square", square}, {"hexagon with two on its axis", hexagon}, {"octahedron", octahedron}};
+}
+
+// Two closed unit tetrahedra, the second shifted 0.2 A along (1,1,1) into
+// the first: a closed oriented manifold that intersects itself.
+inline SurfaceMesh two_interpenetrating_tetrahedra() {
+  SurfaceMesh two;
+  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.2, 0.2)}) {
+    const int base = static_cast<int>(two.vertices.size());
+    for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                     Eigen::Vector3d(0, 0, 1)})
+      two.vertices.push_back(p + shift);
+    for (const std::array<int, 3>& t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}})
+      two.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+  }
+  return two;
 }
 
 }  // namespace skinmesh::test

@@ -1,4 +1,6 @@
 #include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/number_text.hpp"
 
 #include "skinmesh/core/molecule.hpp"
 
@@ -15,7 +17,7 @@ const char* convention_name(WeightConvention convention) {
 std::vector<Ball> balls_from_molecule(const Molecule& molecule, double shrink,
                                       WeightConvention convention) {
   if (!(shrink > 0.0 && shrink < 1.0))
-    throw std::invalid_argument("shrink factor must lie in (0,1), got " + std::to_string(shrink));
+    contract_error("shrink factor must lie in (0,1), got " + std::to_string(shrink));
   std::vector<Ball> balls;
   balls.reserve(molecule.atoms.size());
   for (const Atom& atom : molecule.atoms) {
@@ -33,12 +35,9 @@ void write_wpts(std::ostream& out, const std::vector<Ball>& balls, const std::st
     std::string line;
     while (std::getline(lines, line)) out << "# " << line << '\n';
   }
-  char buffer[128];
-  for (const Ball& b : balls) {
-    std::snprintf(buffer, sizeof buffer, "%.17g %.17g %.17g %.17g\n", b.center[0], b.center[1], b.center[2],
-                  b.weight);
-    out << buffer;
-  }
+  for (const Ball& b : balls)
+    out << exact_number_text(b.center[0]) << ' ' << exact_number_text(b.center[1]) << ' '
+        << exact_number_text(b.center[2]) << ' ' << exact_number_text(b.weight) << '\n';
 }
 
 }  // namespace skinmesh

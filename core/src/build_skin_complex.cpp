@@ -1,6 +1,7 @@
 // Construction of the mixed complex from CGAL's regular triangulation (exact
 // predicates). CGAL stays in this file: the complex it produces is plain data.
 #include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/error.hpp"
 
 #include "regular_triangulation.hpp"
 
@@ -10,7 +11,8 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
+#include <limits>
+#include <numeric>
 
 namespace skinmesh {
 namespace {
@@ -21,13 +23,6 @@ using K = detail::RtKernel;
 using Regular = detail::RegularTriangulation<int>;
 
 using Key = std::array<int, 4>;  // ascending ball indices, padded with -1
-struct KeyHash {
-  size_t operator()(const Key& k) const {
-    size_t h = 1469598103934665603ull;
-    for (int v : k) h = (h ^ static_cast<size_t>(v + 1)) * 1099511628211ull;
-    return h;
-  }
-};
 
 Key make_key(std::array<int, 4> ids, int count) {
   std::sort(ids.begin(), ids.begin() + count);
@@ -36,7 +31,7 @@ Key make_key(std::array<int, 4> ids, int count) {
 }
 
 // Centre z_X (equal power to every ball of X within aff(delta_X)), size R2 and
-// the projector onto the directions of aff(delta_X) (MATH.md section 3).
+// the projector onto the directions of aff(delta_X) (docs/math.md section 3).
 void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
   const Ball& b0 = balls[cell.balls[0]];
   const int d = cell.dim;
@@ -125,12 +120,17 @@ void add_constraints_beyond_flat_cofaces(std::vector<MixedCell>& cells, const st
       for (int f = face_offset[static_cast<size_t>(member)]; f < face_offset[static_cast<size_t>(member) + 1]; ++f) {
         const int x = faces[static_cast<size_t>(f)];
         if (cells[static_cast<size_t>(x)].degenerate) continue;
-        const auto& xb = cells[static_cast<size_t>(x)].balls;
         for (const int t : beyond)
           for (int j = 0; j <= cells[static_cast<size_t>(t)].dim; ++j) {
             const int ball = cells[static_cast<size_t>(t)].balls[static_cast<size_t>(j)];
             if (!std::binary_search(cluster_balls.begin(), cluster_balls.end(), ball))
-              extra[static_cast<size_t>(x)].push_back({ball, t, true, false});
+              {
+              SkinComplexCoface beyond_flat;
+              beyond_flat.ball = ball;
+              beyond_flat.cell = t;
+              beyond_flat.beyond = true;
+              extra[static_cast<size_t>(x)].push_back(beyond_flat);
+            }
           }
       }
   }
@@ -146,125 +146,144 @@ void add_constraints_beyond_flat_cofaces(std::vector<MixedCell>& cells, const st
   coface_offset = std::move(offset);
 }
 
+void check_input(const std::vector<Ball>& balls, const SkinComplexOptions& options) {
+  if (!(options.shrink > 0.0 && options.shrink < 1.0))
+    contract_error("shrink factor must lie in (0,1), got " + std::to_string(options.shrink));
+  if (balls.empty()) contract_error("cannot build a skin complex of no balls");
+  for (const Ball& b : balls)
+    if (!b.center.allFinite() || !std::isfinite(b.weight)) contract_error("ball with a non-finite centre or weight");
+}
+
 }  // namespace
 
-SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options) {
-  if (!(options.shrink > 0.0 && options.shrink < 1.0))
-    throw std::invalid_argument("shrink factor must lie in (0,1), got " + std::to_string(options.shrink));
-  if (balls.empty()) throw std::invalid_argument("cannot build a skin complex of no balls");
-  for (const Ball& b : balls)
-    if (!b.center.allFinite() || !std::isfinite(b.weight))
-      throw std::invalid_argument("ball with a non-finite centre or weight");
-
-  SkinComplex sc;
-  sc.shrink_ = options.shrink;
-  sc.balls_ = std::move(balls);
-  const int n = static_cast<int>(sc.balls_.size());
-
-  std::vector<std::pair<Regular::Weighted_point, int>> points;
-  points.reserve(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const Ball& b = sc.balls_[static_cast<size_t>(i)];
-    points.emplace_back(Regular::Weighted_point(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight), i);
-  }
-  Regular rt(points.begin(), points.end());
-  sc.dimension_ = rt.dimension();
-
-  // Simplices of every dimension, as sorted ball tuples.
-  std::vector<MixedCell>& cells = sc.cells_;
-  auto add = [&](std::array<int, 4> ids, int count) {
-    MixedCell c;
-    c.dim = count - 1;
-    c.balls = make_key(ids, count);
-    cells.push_back(c);
-  };
-  sc.vertex_cell_.assign(static_cast<size_t>(n), -1);
-  for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) {
-    sc.vertex_cell_[static_cast<size_t>(v->info())] = static_cast<int>(cells.size());
-    add({v->info(), -1, -1, -1}, 1);
-  }
-  for (int i = 0; i < n; ++i)
-    if (sc.vertex_cell_[static_cast<size_t>(i)] < 0) sc.hidden_.push_back(i);
-  if (rt.dimension() >= 1)
-    for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e)
-      add({e->first->vertex(e->second)->info(), e->first->vertex(e->third)->info(), -1, -1}, 2);
-  if (rt.dimension() >= 2)
-    for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
-      std::array<int, 4> ids{};
-      for (int k = 0; k < 3; ++k) ids[k] = f->first->vertex((f->second + 1 + k) & 3)->info();
-      add(ids, 3);
+// Builds the parts of a SkinComplex in order; a friend of it.
+struct SkinComplexBuilder {
+  // Simplices of every dimension of the regular triangulation, as sorted ball
+  // tuples; balls without a vertex are hidden.
+  static void add_simplices(const Regular& rt, SkinComplex& sc) {
+    const int n = static_cast<int>(sc.balls_.size());
+    std::vector<MixedCell>& cells = sc.cells_;
+    auto add = [&](std::array<int, 4> ids, int count) {
+      MixedCell c;
+      c.dim = count - 1;
+      c.balls = make_key(ids, count);
+      cells.push_back(c);
+    };
+    sc.vertex_cell_.assign(static_cast<size_t>(n), -1);
+    for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) {
+      sc.vertex_cell_[static_cast<size_t>(v->info())] = static_cast<int>(cells.size());
+      add({v->info(), -1, -1, -1}, 1);
     }
-  if (rt.dimension() == 3)
-    for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c)
-      add({c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()}, 4);
-
-  std::unordered_map<Key, int, KeyHash> index;
-  index.reserve(cells.size() * 2);
-  for (size_t i = 0; i < cells.size(); ++i) index.emplace(cells[i].balls, static_cast<int>(i));
-
-  // Faces (drop one ball) and cofaces (add one ball), in CSR form.
-  const size_t m = cells.size();
-  sc.face_offset_.assign(m + 1, 0);
-  std::vector<int> coface_count(m, 0);
-  for (size_t i = 0; i < m; ++i) sc.face_offset_[i + 1] = sc.face_offset_[i] + (cells[i].dim > 0 ? cells[i].dim + 1 : 0);
-  sc.faces_.assign(static_cast<size_t>(sc.face_offset_[m]), -1);
-  for (size_t i = 0; i < m; ++i) {
-    const MixedCell& c = cells[i];
-    if (c.dim == 0) continue;
-    for (int drop = 0; drop <= c.dim; ++drop) {
-      std::array<int, 4> ids{{-1, -1, -1, -1}};
-      int k = 0;
-      for (int j = 0; j <= c.dim; ++j)
-        if (j != drop) ids[k++] = c.balls[j];
-      const int face = index.at(make_key(ids, k));
-      sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)] = face;
-      ++coface_count[static_cast<size_t>(face)];
-    }
+    for (int i = 0; i < n; ++i)
+      if (sc.vertex_cell_[static_cast<size_t>(i)] < 0) sc.hidden_.push_back(i);
+    if (rt.dimension() >= 1)
+      for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e)
+        add({e->first->vertex(e->second)->info(), e->first->vertex(e->third)->info(), -1, -1}, 2);
+    if (rt.dimension() >= 2)
+      for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
+        std::array<int, 4> ids{};
+        for (int k = 0; k < 3; ++k) ids[static_cast<size_t>(k)] = f->first->vertex((f->second + 1 + k) & 3)->info();
+        add(ids, 3);
+      }
+    if (rt.dimension() == 3)
+      for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c)
+        add({c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()}, 4);
+    // The tuple -> cell lookup (find_cell): indices ordered by tuple.
+    sc.cells_by_balls_.resize(cells.size());
+    std::iota(sc.cells_by_balls_.begin(), sc.cells_by_balls_.end(), 0);
+    std::sort(sc.cells_by_balls_.begin(), sc.cells_by_balls_.end(),
+              [&](int x, int y) { return cells[static_cast<size_t>(x)].balls < cells[static_cast<size_t>(y)].balls; });
   }
-  sc.coface_offset_.assign(m + 1, 0);
-  for (size_t i = 0; i < m; ++i) sc.coface_offset_[i + 1] = sc.coface_offset_[i] + coface_count[i];
-  sc.cofaces_.resize(static_cast<size_t>(sc.coface_offset_[m]));
-  std::vector<int> fill(sc.coface_offset_.begin(), sc.coface_offset_.end() - 1);
-  for (size_t i = 0; i < m; ++i) {
-    const MixedCell& c = cells[i];
-    for (int drop = 0; drop < (c.dim > 0 ? c.dim + 1 : 0); ++drop) {
-      const int face = sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)];
-      sc.cofaces_[static_cast<size_t>(fill[static_cast<size_t>(face)]++)] = {c.balls[drop], static_cast<int>(i), false, false};
+
+  // Faces (drop one ball) and cofaces (add one ball) of every cell, in CSR form.
+  static void link_faces(SkinComplex& sc) {
+    const std::vector<MixedCell>& cells = sc.cells_;
+    const size_t m = cells.size();
+    sc.face_offset_.assign(m + 1, 0);
+    std::vector<int> coface_count(m, 0);
+    for (size_t i = 0; i < m; ++i) sc.face_offset_[i + 1] = sc.face_offset_[i] + (cells[i].dim > 0 ? cells[i].dim + 1 : 0);
+    sc.faces_.assign(static_cast<size_t>(sc.face_offset_[m]), -1);
+    for (size_t i = 0; i < m; ++i) {
+      const MixedCell& c = cells[i];
+      for (int drop = 0; drop < (c.dim > 0 ? c.dim + 1 : 0); ++drop) {
+        std::array<int, 4> ids{{-1, -1, -1, -1}};
+        int k = 0;
+        for (int j = 0; j <= c.dim; ++j)
+          if (j != drop) ids[static_cast<size_t>(k++)] = c.balls[static_cast<size_t>(j)];
+        const int face = sc.find_cell(ids);
+        sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)] = face;
+        ++coface_count[static_cast<size_t>(face)];
+      }
+    }
+    sc.coface_offset_.assign(m + 1, 0);
+    for (size_t i = 0; i < m; ++i) sc.coface_offset_[i + 1] = sc.coface_offset_[i] + coface_count[i];
+    sc.cofaces_.resize(static_cast<size_t>(sc.coface_offset_[m]));
+    std::vector<int> fill(sc.coface_offset_.begin(), sc.coface_offset_.end() - 1);
+    for (size_t i = 0; i < m; ++i) {
+      const MixedCell& c = cells[i];
+      for (int drop = 0; drop < (c.dim > 0 ? c.dim + 1 : 0); ++drop) {
+        const int face = sc.faces_[static_cast<size_t>(sc.face_offset_[i] + drop)];
+        SkinComplexCoface coface;
+        coface.ball = c.balls[static_cast<size_t>(drop)];
+        coface.cell = static_cast<int>(i);
+        sc.cofaces_[static_cast<size_t>(fill[static_cast<size_t>(face)]++)] = coface;
+      }
     }
   }
 
-  for (MixedCell& c : cells) compute_cell_geometry(c, sc.balls_);
-  add_constraints_beyond_flat_cofaces(cells, sc.faces_, sc.face_offset_, sc.cofaces_, sc.coface_offset_);
-
-  // Start-point grid over the centres of the non-hidden balls.
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
-  Eigen::Vector3d hi = -lo;
-  std::vector<int> live;
-  for (int i = 0; i < n; ++i)
-    if (sc.vertex_cell_[static_cast<size_t>(i)] >= 0) {
-      live.push_back(i);
-      lo = lo.cwiseMin(sc.balls_[static_cast<size_t>(i)].center);
-      hi = hi.cwiseMax(sc.balls_[static_cast<size_t>(i)].center);
-    }
-  const Eigen::Vector3d extent = (hi - lo).cwiseMax(1e-9);
-  const double volume = extent.prod();
-  sc.grid_step_ = std::max({2.0, std::cbrt(volume / static_cast<double>(live.size()) * 2.0), extent.maxCoeff() / 256.0});
-  sc.grid_origin_ = lo;
-  for (int k = 0; k < 3; ++k) sc.grid_size_[k] = std::max(1, static_cast<int>(std::floor(extent[k] / sc.grid_step_)) + 1);
-  const size_t buckets = static_cast<size_t>(sc.grid_size_[0]) * sc.grid_size_[1] * sc.grid_size_[2];
-  sc.grid_offset_.assign(buckets + 1, 0);
-  auto bucket_of = [&](const Eigen::Vector3d& p) {
-    std::array<int, 3> b{};
+  // A uniform grid over the centres of the non-hidden balls: walks start from
+  // the vertex cell of the ball of least power in the nearest buckets.
+  static void build_start_grid(SkinComplex& sc) {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+    Eigen::Vector3d hi = -lo;
+    std::vector<int> live;
+    for (int i = 0; i < static_cast<int>(sc.balls_.size()); ++i)
+      if (sc.vertex_cell_[static_cast<size_t>(i)] >= 0) {
+        live.push_back(i);
+        lo = lo.cwiseMin(sc.balls_[static_cast<size_t>(i)].center);
+        hi = hi.cwiseMax(sc.balls_[static_cast<size_t>(i)].center);
+      }
+    const Eigen::Vector3d extent = (hi - lo).cwiseMax(1e-9);
+    const double volume = extent.prod();
+    sc.grid_step_ = std::max({2.0, std::cbrt(volume / static_cast<double>(live.size()) * 2.0), extent.maxCoeff() / 256.0});
+    sc.grid_origin_ = lo;
     for (int k = 0; k < 3; ++k)
-      b[k] = std::clamp(static_cast<int>((p[k] - sc.grid_origin_[k]) / sc.grid_step_), 0, sc.grid_size_[k] - 1);
-    return (static_cast<size_t>(b[2]) * sc.grid_size_[1] + b[1]) * sc.grid_size_[0] + b[0];
-  };
-  for (int i : live) ++sc.grid_offset_[bucket_of(sc.balls_[static_cast<size_t>(i)].center) + 1];
-  for (size_t b = 0; b < buckets; ++b) sc.grid_offset_[b + 1] += sc.grid_offset_[b];
-  sc.grid_balls_.resize(live.size());
-  std::vector<int> cursor(sc.grid_offset_.begin(), sc.grid_offset_.end() - 1);
-  for (int i : live) sc.grid_balls_[static_cast<size_t>(cursor[bucket_of(sc.balls_[static_cast<size_t>(i)].center)]++)] = i;
-  return sc;
+      sc.grid_size_[static_cast<size_t>(k)] = std::max(1, static_cast<int>(std::floor(extent[k] / sc.grid_step_)) + 1);
+    const size_t buckets = static_cast<size_t>(sc.grid_size_[0]) * sc.grid_size_[1] * sc.grid_size_[2];
+    sc.grid_offset_.assign(buckets + 1, 0);
+    auto bucket_of = [&](int ball) { return sc.grid_bucket(sc.grid_cell_of(sc.balls_[static_cast<size_t>(ball)].center)); };
+    for (int i : live) ++sc.grid_offset_[bucket_of(i) + 1];
+    for (size_t b = 0; b < buckets; ++b) sc.grid_offset_[b + 1] += sc.grid_offset_[b];
+    sc.grid_balls_.resize(live.size());
+    std::vector<int> cursor(sc.grid_offset_.begin(), sc.grid_offset_.end() - 1);
+    for (int i : live) sc.grid_balls_[static_cast<size_t>(cursor[bucket_of(i)]++)] = i;
+  }
+
+  static SkinComplex build(std::vector<Ball> balls, const SkinComplexOptions& options) {
+    check_input(balls, options);
+    SkinComplex sc;
+    sc.shrink_ = options.shrink;
+    sc.balls_ = std::move(balls);
+    std::vector<std::pair<Regular::Weighted_point, int>> points;
+    points.reserve(sc.balls_.size());
+    for (size_t i = 0; i < sc.balls_.size(); ++i) {
+      const Ball& b = sc.balls_[i];
+      points.emplace_back(Regular::Weighted_point(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight),
+                          static_cast<int>(i));
+    }
+    const Regular rt(points.begin(), points.end());
+    sc.dimension_ = rt.dimension();
+    add_simplices(rt, sc);
+    link_faces(sc);
+    for (MixedCell& c : sc.cells_) compute_cell_geometry(c, sc.balls_);
+    add_constraints_beyond_flat_cofaces(sc.cells_, sc.faces_, sc.face_offset_, sc.cofaces_, sc.coface_offset_);
+    build_start_grid(sc);
+    return sc;
+  }
+};
+
+SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options) {
+  return SkinComplexBuilder::build(std::move(balls), options);
 }
 
 }  // namespace skinmesh

@@ -11,13 +11,16 @@ std::string format_input_error(const std::string& file, long line, const std::st
 }  // namespace
 
 InputError::InputError(std::string file, long line, const std::string& message)
-    : std::runtime_error(format_input_error(file, line, message)),
-      file_(std::move(file)),
-      line_(line),
-      message_(message) {}
+    : Error(format_input_error(file, line, message)), file_(std::move(file)), line_(line), message_(message) {}
 
 void input_error(const std::string& file, long line, const std::string& message) {
   throw InputError(file, line, message);
+}
+
+void contract_error(const std::string& message) { throw ContractError(message); }
+
+void output_error(const std::string& path, const std::string& message) {
+  throw OutputError(path.empty() ? message : path + ": " + message);
 }
 
 }  // namespace skinmesh

@@ -1,5 +1,6 @@
 // The interpolated set of a morph and its live pairs (see interpolation.hpp).
 #include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/error.hpp"
 
 #include "regular_triangulation.hpp"
 
@@ -61,7 +62,7 @@ std::vector<BallPair> all_pairs(size_t m, size_t n) {
 }
 
 std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target) {
-  if (source.empty() || target.empty()) throw std::invalid_argument("live_pairs: an empty ball set");
+  if (source.empty() || target.empty()) contract_error("live_pairs: an empty ball set");
   const PowerDiagram a(source), b(target);
   const long n = static_cast<long>(target.size());
   // The overlay's cells are connected through facets, and a facet between

@@ -78,15 +78,9 @@ std::vector<detail::RawAtom> pick_conformers(std::vector<detail::RawAtom> atoms,
   return kept;
 }
 
-Molecule filter_model(const std::string& path, MoleculeFormat format, detail::RawModel raw, int model_number,
-                      int models_in_file, const ReadOptions& options, const std::vector<std::string>& warnings) {
-  Molecule m;
-  m.source = path;
-  m.format = format;
-  m.model = model_number;
-  m.models_in_file = models_in_file;
-  m.warnings = warnings;
-
+// The atoms of the selected chains, less waters and hydrogens unless kept,
+// one conformer each; what was dropped is counted in m.skipped.
+std::vector<detail::RawAtom> select_atoms(detail::RawModel raw, const ReadOptions& options, Molecule& m) {
   std::vector<detail::RawAtom> atoms;
   atoms.reserve(raw.size());
   for (detail::RawAtom& r : raw) {
@@ -108,7 +102,13 @@ Molecule filter_model(const std::string& path, MoleculeFormat format, detail::Ra
   long altloc_dropped = 0;
   atoms = pick_conformers(std::move(atoms), altloc_dropped);
   if (altloc_dropped) m.skipped["alternate location"] += altloc_dropped;
+  return atoms;
+}
 
+// Checks each atom's coordinates and gives it its radius (Bondi's by element
+// unless the file gave one); atoms of zero given radius are dropped.
+void add_atoms_with_radii(const std::string& path, std::vector<detail::RawAtom> atoms, const ReadOptions& options,
+                          Molecule& m) {
   for (detail::RawAtom& r : atoms) {
     Atom& a = r.atom;
     for (int k = 0; k < 3; ++k) {
@@ -141,20 +141,23 @@ Molecule filter_model(const std::string& path, MoleculeFormat format, detail::Ra
         << options.unknown_radius << " A";
     m.warnings.push_back(msg.str());
   }
+}
 
-  if (m.atoms.empty()) {
-    std::ostringstream msg;
-    msg << "no atoms left after filtering";
-    if (!m.skipped.empty()) {
-      msg << " (dropped:";
-      for (const auto& [reason, count] : m.skipped) msg << " " << count << " " << reason;
-      msg << "; see --keep-hydrogens, --keep-waters, --chain)";
-    }
-    input_error(path, 0, msg.str());
+void require_atoms(const std::string& path, const Molecule& m) {
+  if (!m.atoms.empty()) return;
+  std::ostringstream msg;
+  msg << "no atoms left after filtering";
+  if (!m.skipped.empty()) {
+    msg << " (dropped:";
+    for (const auto& [reason, count] : m.skipped) msg << " " << count << " " << reason;
+    msg << "; keep hydrogens or waters, or select other chains, to keep more)";
   }
+  input_error(path, 0, msg.str());
+}
 
-  // Atoms at one position: geometrically the smaller ball is hidden (a
-  // duplicate is hidden by its twin), so this is a warning, not an error.
+// Atoms at one position: geometrically the smaller ball is hidden (a
+// duplicate is hidden by its twin), so this is a warning, not an error.
+void warn_coincident_atoms(const std::string& path, Molecule& m) {
   struct Hash {
     size_t operator()(const Eigen::Vector3d& p) const {
       std::hash<double> h;
@@ -169,15 +172,26 @@ Molecule filter_model(const std::string& path, MoleculeFormat format, detail::Ra
   std::string first_pair;
   for (size_t i = 0; i < m.atoms.size(); ++i) {
     auto [it, inserted] = seen.emplace(m.atoms[i].position, i);
-    if (!inserted) {
-      if (coincident++ == 0)
-        first_pair = where(path, m.atoms[it->second]) + " and " + where(path, m.atoms[i]);
-    }
+    if (!inserted && coincident++ == 0)
+      first_pair = where(path, m.atoms[it->second]) + " and " + where(path, m.atoms[i]);
   }
   if (coincident)
     m.warnings.push_back(path + ": " + std::to_string(coincident) +
                          " atom(s) share a position with another atom, first " + first_pair +
                          "; the smaller ball of each group is hidden");
+}
+
+Molecule filter_model(const std::string& path, MoleculeFormat format, detail::RawModel raw, int model_number,
+                      int models_in_file, const ReadOptions& options, const std::vector<std::string>& warnings) {
+  Molecule m;
+  m.source = path;
+  m.format = format;
+  m.model = model_number;
+  m.models_in_file = models_in_file;
+  m.warnings = warnings;
+  add_atoms_with_radii(path, select_atoms(std::move(raw), options, m), options, m);
+  require_atoms(path, m);
+  warn_coincident_atoms(path, m);
   return m;
 }
 

@@ -1,6 +1,6 @@
 // Queries on the mixed complex: location by walking, the skin function (the
-// per-cell quadric of MATH.md section 3), projection, segment crossings and
-// curvature.
+// per-cell quadric of docs/math.md section 3), projection, segment crossings
+// and curvature.
 #include "skinmesh/core/skin_complex.hpp"
 
 #include <Eigen/Dense>
@@ -24,6 +24,48 @@ struct Violation {
   int target = -1;
 };
 
+// The cell's quadric along the line x = a + t dir (docs/math.md section 3):
+//   Q_X(a + t dir) = A t^2 + B t + C,
+//   Q_X(x) = (1-s)|(I-P)(x-z)|^2 - s|P(x-z)|^2 + s(1-s) R2.
+// The one place Q_X is written; with dir = 0, C is Q_X(a).
+struct LineQuadric {
+  double A = 0, B = 0, C = 0;
+};
+LineQuadric quadric_on_line(const MixedCell& cell, double s, const Eigen::Vector3d& a, const Eigen::Vector3d& dir) {
+  const Eigen::Vector3d y0 = a - cell.center;
+  const Eigen::Vector3d pd = cell.P * dir, py = cell.P * y0;
+  LineQuadric q;
+  q.A = (1 - s) * (dir - pd).squaredNorm() - s * pd.squaredNorm();
+  q.B = 2.0 * ((1 - s) * (y0 - py).dot(dir - pd) - s * py.dot(pd));
+  q.C = (1 - s) * (y0 - py).squaredNorm() - s * py.squaredNorm() + s * (1 - s) * cell.R2;
+  return q;
+}
+
+// grad F = grad Q_X / (1-s) = 2 (I-P) y - 2s/(1-s) P y at y = x - z; its
+// Hessian, constant on the cell, is 2 (I-P) - 2s/(1-s) P.
+Eigen::Vector3d skin_gradient(const MixedCell& cell, double s, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d py = cell.P * y;
+  return 2.0 * (y - py) - (2.0 * s / (1 - s)) * py;
+}
+
+// Roots of A t^2 + B t + C in ascending order (the numerically stable form).
+int quadratic_roots(const LineQuadric& q, double roots[2]) {
+  int count = 0;
+  const double scale = std::abs(q.A) + std::abs(q.B) + std::abs(q.C);
+  if (std::abs(q.A) <= 1e-15 * scale) {
+    if (q.B != 0.0) roots[count++] = -q.C / q.B;
+    return count;
+  }
+  const double disc = q.B * q.B - 4 * q.A * q.C;
+  if (disc < 0) return 0;
+  const double root = -0.5 * (q.B + std::copysign(std::sqrt(disc), q.B));
+  roots[count++] = root / q.A;
+  if (root != 0.0) roots[count++] = q.C / root;
+  if (count == 2 && roots[0] > roots[1]) std::swap(roots[0], roots[1]);
+  return count;
+}
+
 }  // namespace
 
 double PrincipalCurvatures::max_abs() const { return std::max(std::abs(k1), std::abs(k2)); }
@@ -39,11 +81,29 @@ long SkinComplex::degenerate_cell_count() const {
 }
 
 double SkinComplex::quadric(int c, const Eigen::Vector3d& x) const {
-  const MixedCell& cell = cells_[static_cast<size_t>(c)];
-  const double s = shrink_;
-  const Eigen::Vector3d y = x - cell.center;
-  const Eigen::Vector3d py = cell.P * y;
-  return (1 - s) * (y - py).squaredNorm() - s * py.squaredNorm() + s * (1 - s) * cell.R2;
+  return quadric_on_line(cells_[static_cast<size_t>(c)], shrink_, x, Eigen::Vector3d::Zero()).C;
+}
+
+int SkinComplex::find_cell(std::array<int, 4> balls) const {
+  // Ascending ball indices, the unused entries (-1) last: the order of MixedCell::balls.
+  for (size_t i = 1; i < balls.size(); ++i)
+    for (size_t j = i; j > 0; --j) {
+      const int a = balls[j - 1], b = balls[j];
+      if (!(a < 0 ? b >= 0 : b >= 0 && b < a)) break;
+      std::swap(balls[j - 1], balls[j]);
+    }
+  const auto it = std::lower_bound(cells_by_balls_.begin(), cells_by_balls_.end(), balls,
+                                   [&](int c, const std::array<int, 4>& key) { return cells_[static_cast<size_t>(c)].balls < key; });
+  if (it == cells_by_balls_.end() || cells_[static_cast<size_t>(*it)].balls != balls) return -1;
+  return *it;
+}
+
+std::array<int, 3> SkinComplex::grid_cell_of(const Eigen::Vector3d& x) const {
+  std::array<int, 3> g{};
+  for (int k = 0; k < 3; ++k)
+    g[static_cast<size_t>(k)] = std::clamp(static_cast<int>(std::floor((x[k] - grid_origin_[k]) / grid_step_)), 0,
+                                           grid_size_[static_cast<size_t>(k)] - 1);
+  return g;
 }
 
 // x = (1-s) d + s v with d = z + P(x-z)/(1-s) in aff(delta_X) and v = z + (I-P)(x-z)/s
@@ -92,9 +152,7 @@ double SkinComplex::membership_violation(int c, const Eigen::Vector3d& x) const 
 }
 
 int SkinComplex::start_cell(const Eigen::Vector3d& x) const {
-  std::array<int, 3> b{};
-  for (int k = 0; k < 3; ++k)
-    b[k] = std::clamp(static_cast<int>(std::floor((x[k] - grid_origin_[k]) / grid_step_)), 0, grid_size_[k] - 1);
+  const std::array<int, 3> b = grid_cell_of(x);
   int best = -1;
   double best_power = std::numeric_limits<double>::infinity();
   const int max_ring = std::max({grid_size_[0], grid_size_[1], grid_size_[2]});
@@ -105,7 +163,7 @@ int SkinComplex::start_cell(const Eigen::Vector3d& x) const {
         for (int k = b[2] - ring; k <= b[2] + ring; ++k) {
           if (std::max({std::abs(i - b[0]), std::abs(j - b[1]), std::abs(k - b[2])}) != ring) continue;
           if (i < 0 || j < 0 || k < 0 || i >= grid_size_[0] || j >= grid_size_[1] || k >= grid_size_[2]) continue;
-          const size_t bucket = (static_cast<size_t>(k) * grid_size_[1] + j) * grid_size_[0] + i;
+          const size_t bucket = grid_bucket({i, j, k});
           for (int p = grid_offset_[bucket]; p < grid_offset_[bucket + 1]; ++p) {
             const int ball = grid_balls_[static_cast<size_t>(p)];
             const double power = balls_[static_cast<size_t>(ball)].power(x);
@@ -149,11 +207,8 @@ SkinEval SkinComplex::evaluate(const Eigen::Vector3d& x, int hint) const {
   SkinEval e;
   e.cell = locate(x, hint);
   const MixedCell& cell = cells_[static_cast<size_t>(e.cell)];
-  const double s = shrink_;
-  const Eigen::Vector3d y = x - cell.center;
-  const Eigen::Vector3d py = cell.P * y;
-  e.value = (y - py).squaredNorm() - s / (1 - s) * py.squaredNorm() + s * cell.R2;  // Q_X / (1-s)
-  e.gradient = 2.0 * (y - py) - (2.0 * s / (1 - s)) * py;
+  e.value = quadric(e.cell, x) / (1 - shrink_);  // F = Q_X / (1-s) on mu_X
+  e.gradient = skin_gradient(cell, shrink_, x);
   return e;
 }
 
@@ -261,11 +316,54 @@ Projection SkinComplex::project(const Eigen::Vector3d& x0, int hint, double tole
   return p;
 }
 
+// Where the segment a + t dir (t >= t_floor) leaves mu_c, and the cell across:
+// every membership constraint of worst_violation is affine in t.
+struct CellExit {
+  double t = std::numeric_limits<double>::infinity();
+  int next = -1;
+  bool beyond = false;  // `next` is past a flat coface, not adjacent
+};
+static CellExit segment_exit(const SkinComplex& sc, int c, const Eigen::Vector3d& a, const Eigen::Vector3d& dir,
+                             double t_floor) {
+  const MixedCell& cell = sc.cell(c);
+  const double s = sc.shrink();
+  const Ball& b0 = sc.balls()[static_cast<size_t>(cell.balls[0])];
+  const Eigen::Vector3d y0 = a - cell.center;
+  CellExit exit;
+  auto consider = [&](double value0, double slope, int target, bool beyond) {
+    if (slope >= 0) return;
+    const double crossing = std::max(t_floor, -value0 / slope);
+    if (crossing < exit.t) exit = {crossing, target, beyond};
+  };
+  if (cell.dim > 0) {
+    const Eigen::Vector3d d0 = cell.center + cell.P * y0 / (1 - s) - b0.center;
+    const Eigen::Vector3d d1 = cell.P * dir / (1 - s);
+    const Eigen::Vector3d A0 = cell.to_affine * d0, A1 = cell.to_affine * d1;
+    double bary0 = 1.0, slope0 = 0.0;
+    for (int j = 0; j < cell.dim; ++j) {
+      bary0 -= A0[j];
+      slope0 -= A1[j];
+    }
+    const int* faces = sc.faces_begin(c);
+    consider(bary0, slope0, faces[0], false);
+    for (int j = 1; j <= cell.dim; ++j) consider(A0[j - 1], A1[j - 1], faces[j], false);
+  }
+  const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
+  const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;
+  for (auto it = sc.cofaces_begin(c); it != sc.cofaces_end(c); ++it) {
+    if (it->flat) continue;  // void bound (see worst_violation)
+    const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
+    // pi_k(v) - pi_0(v) = -2 <v, z_k - z_0> + |z_k|^2 - w_k - |z_0|^2 + w_0
+    const Eigen::Vector3d dz = bk.center - b0.center;
+    consider(bk.power(v0) - b0.power(v0), -2.0 * v1.dot(dz), it->cell, it->beyond);
+  }
+  return exit;
+}
+
 std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                             int hint) const {
   std::vector<SegmentCrossing> out;
   const Eigen::Vector3d dir = b - a;
-  const double s = shrink_;
   if (dir.squaredNorm() == 0.0) return out;
   int c = locate(a, hint);
   double t = 0.0;        // crossings are searched from here
@@ -273,86 +371,32 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
   int stalled = 0;
   const int max_cells = 20000;
   for (int visit = 0; visit < max_cells; ++visit) {
-    const MixedCell& cell = cells_[static_cast<size_t>(c)];
-    if (cell.degenerate) {  // holds nothing: continue from the cell really there
+    if (cells_[static_cast<size_t>(c)].degenerate) {  // holds nothing: continue from the cell really there
       c = locate(a + t * dir, *faces_begin(c));
       continue;
     }
-    const Ball& b0 = balls_[static_cast<size_t>(cell.balls[0])];
-    const Eigen::Vector3d y0 = a - cell.center;
-
-    // Where the segment leaves mu_c: every constraint is affine in t.
-    double t_exit = std::numeric_limits<double>::infinity();
-    int next = -1;
-    bool next_beyond = false;
-    auto consider = [&](double value0, double slope, int target, bool beyond = false) {
-      if (slope >= 0) return;
-      const double crossing = std::max(t_floor, -value0 / slope);
-      if (crossing < t_exit) {
-        t_exit = crossing;
-        next = target;
-        next_beyond = beyond;
-      }
-    };
-    if (cell.dim > 0) {
-      const Eigen::Vector3d d0 = cell.center + cell.P * y0 / (1 - s) - b0.center;
-      const Eigen::Vector3d d1 = cell.P * dir / (1 - s);
-      const Eigen::Vector3d A0 = cell.to_affine * d0, A1 = cell.to_affine * d1;
-      double bary0 = 1.0, slope0 = 0.0;
-      for (int j = 0; j < cell.dim; ++j) {
-        bary0 -= A0[j];
-        slope0 -= A1[j];
-      }
-      const int* faces = faces_begin(c);
-      consider(bary0, slope0, faces[0]);
-      for (int j = 1; j <= cell.dim; ++j) consider(A0[j - 1], A1[j - 1], faces[j]);
-    }
-    const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
-    const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;
-    for (auto it = cofaces_begin(c); it != cofaces_end(c); ++it) {
-      if (it->flat) continue;  // void bound (see worst_violation)
-      const Ball& bk = balls_[static_cast<size_t>(it->ball)];
-      // pi_k(v) - pi_0(v) = -2 <v, z_k - z_0> + |z_k|^2 - w_k - |z_0|^2 + w_0
-      const Eigen::Vector3d dz = bk.center - b0.center;
-      consider(bk.power(v0) - b0.power(v0), -2.0 * v1.dot(dz), it->cell, it->beyond);
-    }
-
-    // Roots of Q_c(a + t dir) = A t^2 + B t + C on [t, min(t_exit, 1)].
-    const double hi = std::min(t_exit, 1.0);
-    const Eigen::Vector3d pd = cell.P * dir, py = cell.P * y0;
-    const double A = (1 - s) * (dir - pd).squaredNorm() - s * pd.squaredNorm();
-    const double B = 2.0 * ((1 - s) * (y0 - py).dot(dir - pd) - s * py.dot(pd));
-    const double C = (1 - s) * (y0 - py).squaredNorm() - s * py.squaredNorm() + s * (1 - s) * cell.R2;
+    const CellExit exit = segment_exit(*this, c, a, dir, t_floor);
+    // Roots of Q_c(a + t dir) on [t, min(t_exit, 1)]: the skin is a quadric in the cell.
+    const double hi = std::min(exit.t, 1.0);
+    const LineQuadric q = quadric_on_line(cells_[static_cast<size_t>(c)], shrink_, a, dir);
     double roots[2];
-    int count = 0;
-    const double scale = std::abs(A) + std::abs(B) + std::abs(C);
-    if (std::abs(A) <= 1e-15 * scale) {
-      if (B != 0.0) roots[count++] = -C / B;
-    } else {
-      const double disc = B * B - 4 * A * C;
-      if (disc >= 0) {
-        const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
-        roots[count++] = q / A;
-        if (q != 0.0) roots[count++] = C / q;
-        if (count == 2 && roots[0] > roots[1]) std::swap(roots[0], roots[1]);
-      }
-    }
+    const int count = quadratic_roots(q, roots);
     const double eps = 1e-13;
     for (int r = 0; r < count; ++r) {
       const double u = roots[r];
       if (u < t - eps || u > hi + eps || u < -eps || u > 1 + eps) continue;
       const double uc = std::clamp(u, 0.0, 1.0);
       if (!out.empty() && std::abs(out.back().t - uc) < 1e-10) continue;
-      out.push_back({uc, a + uc * dir, c, 2 * A * u + B < 0});
+      out.push_back({uc, a + uc * dir, c, 2 * q.A * u + q.B < 0});
     }
-    if (t_exit >= 1.0 || next < 0) break;
+    if (exit.t >= 1.0 || exit.next < 0) break;
 
     // Zero-length steps go round a face where several cells meet (many of
     // them of zero size where balls are cospherical); after a few, locate
     // slightly further along and go on from there. Crossings are still
     // searched from t, with the quadric of the cell found, which equals the
     // skin function there by continuity, so none is lost in the step.
-    if (t_exit <= t_floor) {
+    if (exit.t <= t_floor) {
       if (++stalled > 2) {
         t_floor = std::min(1.0, t_floor + 1e-9);
         c = locate(a + t_floor * dir, c);
@@ -362,9 +406,9 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
     } else {
       stalled = 0;
     }
-    t = t_floor = t_exit;
+    t = t_floor = exit.t;
     // A cell past a flat coface is not adjacent: find the one really there.
-    c = next_beyond ? locate(a + t * dir, next) : next;
+    c = exit.beyond ? locate(a + t * dir, exit.next) : exit.next;
   }
   return out;
 }
@@ -373,9 +417,8 @@ PrincipalCurvatures SkinComplex::curvature(const Eigen::Vector3d& x, int c) cons
   const MixedCell& cell = cells_[static_cast<size_t>(c)];
   const double s = shrink_;
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  // F = Q/(1-s): gradient 2(I-P)y - 2s/(1-s) P y, constant Hessian 2(I-P) - 2s/(1-s) P.
-  const Eigen::Vector3d y = x - cell.center;
-  const Eigen::Vector3d g = 2.0 * (y - cell.P * y) - (2.0 * s / (1 - s)) * (cell.P * y);
+  // F = Q/(1-s): the gradient of skin_gradient, and its constant Hessian.
+  const Eigen::Vector3d g = skin_gradient(cell, s, x);
   const Eigen::Matrix3d H = 2.0 * (I - cell.P) - (2.0 * s / (1 - s)) * cell.P;
   PrincipalCurvatures pc;
   const double gn = g.norm();

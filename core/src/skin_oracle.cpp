@@ -3,6 +3,7 @@
 // followed by a check of the KKT conditions against every ball; balls that
 // violate them join the candidates and the solve repeats.
 #include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/error.hpp"
 
 #include <Eigen/Dense>
 
@@ -19,8 +20,8 @@ double OracleResult::distance() const {
 }
 
 SkinOracle::SkinOracle(std::vector<Ball> balls, double shrink) : balls_(std::move(balls)), shrink_(shrink) {
-  if (balls_.empty()) throw std::invalid_argument("SkinOracle needs at least one ball");
-  if (!(shrink > 0 && shrink < 1)) throw std::invalid_argument("shrink factor must lie in (0,1)");
+  if (balls_.empty()) contract_error("SkinOracle needs at least one ball");
+  if (!(shrink > 0 && shrink < 1)) contract_error("shrink factor must lie in (0,1)");
 }
 
 namespace {

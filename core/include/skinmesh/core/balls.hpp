@@ -11,7 +11,7 @@ namespace skinmesh {
 
 struct Molecule;
 
-// A weighted point b = (z, w): power distance pi_b(x) = |x - z|^2 - w (MATH.md 1).
+// A weighted point b = (z, w): power distance pi_b(x) = |x - z|^2 - w (docs/math.md 1).
 struct Ball {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // Angstrom
   double weight = 0.0;                               // Angstrom^2 (may be negative in a morph)

@@ -1,5 +1,11 @@
-// One way to fail on bad input: an InputError that names the file, the line
-// (when there is one) and what was wrong. Thrown through input_error().
+// One exception family for everything skinmesh throws. Expected outcomes of
+// the algorithms (a refinement over its budget, a guarantee not met, TetGen
+// giving up) are not exceptions: they are statuses in the result structs.
+//   Error          the base: catch it to catch anything skinmesh throws
+//   InputError     bad input data: names the file, the line and what was wrong
+//   ContractError  a caller broke a documented precondition (an option out of
+//                  its range, an empty ball set)
+//   OutputError    a file could not be written
 #pragma once
 
 #include <stdexcept>
@@ -7,7 +13,12 @@
 
 namespace skinmesh {
 
-class InputError : public std::runtime_error {
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class InputError : public Error {
  public:
   InputError(std::string file, long line, const std::string& message);
   const std::string& file() const { return file_; }
@@ -20,7 +31,20 @@ class InputError : public std::runtime_error {
   std::string message_;
 };
 
-// Throws InputError; the text reads "FILE:LINE: MESSAGE" (or "FILE: MESSAGE").
+class ContractError : public Error {
+ public:
+  using Error::Error;
+};
+
+class OutputError : public Error {
+ public:
+  using Error::Error;
+};
+
+// Throw through these. input_error's text reads "FILE:LINE: MESSAGE" (or
+// "FILE: MESSAGE"); output_error's "PATH: MESSAGE".
 [[noreturn]] void input_error(const std::string& file, long line, const std::string& message);
+[[noreturn]] void contract_error(const std::string& message);
+[[noreturn]] void output_error(const std::string& path, const std::string& message);
 
 }  // namespace skinmesh

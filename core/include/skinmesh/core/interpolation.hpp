@@ -1,4 +1,4 @@
-// The interpolated ball set of a morph (MATH.md sections 1 and 4):
+// The interpolated ball set of a morph (docs/math.md sections 1 and 4):
 // B(t) = { (1-t) a_i + t b_j }, and which of its m*n pairs matter.
 #pragma once
 
@@ -25,7 +25,7 @@ std::vector<BallPair> all_pairs(size_t m, size_t n);
 // The live pairs: those whose power cells, a_i's in the source's power
 // diagram and b_j's in the target's, overlap in an open set. For every t in
 // (0,1) these are exactly the balls of B(t) that are not hidden in its
-// regular triangulation (its power diagram is the overlay of the two, MATH.md
+// regular triangulation (its power diagram is the overlay of the two, docs/math.md
 // section 4), about m + n of them. Found by a walk over the overlay from the
 // pairs holding the balls' centres, each candidate tested by insertion into
 // the regular triangulation of B(1/2). Sorted. A pair whose overlay cell has

@@ -1,4 +1,4 @@
-// The mixed complex of a ball set and the skin surface on it (MATH.md section 3;
+// The mixed complex of a ball set and the skin surface on it (docs/math.md section 3;
 // H. Edelsbrunner, "Deformable smooth surface design", Discrete Comput. Geom. 21
 // (1999) 87-115). Built once from the regular triangulation (CGAL, exact
 // predicates, used only inside build); afterwards a plain value that answers
@@ -61,6 +61,8 @@ struct PrincipalCurvatures {
   double max_abs() const;
 };
 
+struct SkinComplexBuilder;
+
 struct SkinComplexOptions {
   double shrink = 0.5;                     // s in (0,1)
 };
@@ -76,6 +78,13 @@ class SkinComplex {
   std::array<long, 4> cell_counts() const;                          // by dimension of delta_X
   long degenerate_cell_count() const;
   int vertex_cell(int ball) const { return vertex_cell_[static_cast<size_t>(ball)]; }  // -1 if hidden
+
+  // The stable identity of a mixed cell is its ball tuple X (MixedCell::balls),
+  // not its index: two builds of the same balls may number their cells
+  // differently, and a mesh vertex keeps its cell across a rebuild by looking
+  // its tuple up here. `balls` in any order, unused entries -1. Returns the
+  // cell's index, or -1 when X is no simplex of this complex.
+  int find_cell(std::array<int, 4> balls) const;
 
   // Faces of a cell (X minus one ball; the i-th drops balls[i]) and cofaces
   // (X plus one ball), each with the ball whose power bounds nu_X. Where a
@@ -116,11 +125,17 @@ class SkinComplex {
   PrincipalCurvatures curvature(const Eigen::Vector3d& x, int cell) const;
 
  private:
-  friend SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options);
+  friend struct SkinComplexBuilder;  // build_skin_complex.cpp
   int start_cell(const Eigen::Vector3d& x) const;
   Projection project_onto(const Eigen::Vector3d& x, int hint, double tolerance) const;
   std::optional<SegmentCrossing> nearest_crossing_on_rays(const Eigen::Vector3d& x, double reach, int hint) const;
   int locate_by_search(const Eigen::Vector3d& x) const;
+  std::array<int, 3> grid_cell_of(const Eigen::Vector3d& x) const;  // clamped to the grid
+  size_t grid_bucket(const std::array<int, 3>& g) const {
+    return (static_cast<size_t>(g[2]) * static_cast<size_t>(grid_size_[1]) + static_cast<size_t>(g[1])) *
+               static_cast<size_t>(grid_size_[0]) +
+           static_cast<size_t>(g[0]);
+  }
 
   double shrink_ = 0.5;
   int dimension_ = -1;
@@ -131,6 +146,7 @@ class SkinComplex {
   std::vector<int> face_offset_, faces_;
   std::vector<int> coface_offset_;
   std::vector<Coface> cofaces_;
+  std::vector<int> cells_by_balls_;  // cell indices ordered by their ball tuples (find_cell)
   // Uniform grid over the centres of the non-hidden balls: a start for walks.
   Eigen::Vector3d grid_origin_ = Eigen::Vector3d::Zero();
   double grid_step_ = 1.0;
@@ -138,7 +154,7 @@ class SkinComplex {
   std::vector<int> grid_offset_, grid_balls_;
 };
 
-// Throws std::invalid_argument on an empty or non-finite ball set or a shrink
+// Throws ContractError on an empty or non-finite ball set or a shrink
 // factor outside (0,1).
 SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options = {});
 

@@ -1,4 +1,4 @@
-// The skin function as one convex minimisation (MATH.md section 2):
+// The skin function as one convex minimisation (docs/math.md section 2):
 //     F_B(x) = min over l in the simplex of (1-s)|x - Z l|^2 + s sum_i l_i pi_i(x).
 // A second implementation of the skin, independent of the mixed complex: it
 // never builds a triangulation. Each answer is certified by the optimality

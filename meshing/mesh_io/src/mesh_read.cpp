@@ -1,0 +1,518 @@
+#include "skinmesh/mesh_io/mesh_read.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/file_names.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace skinmesh {
+namespace {
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) input_error(path, 0, "cannot open mesh file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (s.str().empty()) input_error(path, 0, "file is empty");
+  return s.str();
+}
+
+// Adds a polygon as a fan of triangles, checking its indices.
+void add_polygon(SurfaceMesh& mesh, const std::vector<long>& corners, const std::string& path, long line) {
+  if (corners.size() < 3) input_error(path, line, "face with fewer than 3 corners");
+  for (long c : corners)
+    if (c < 0 || c >= static_cast<long>(mesh.vertices.size()))
+      input_error(path, line, "face refers to vertex " + std::to_string(c) + ", but there are " +
+                                  std::to_string(mesh.vertices.size()));
+  for (size_t k = 1; k + 1 < corners.size(); ++k)
+    mesh.triangles.push_back({static_cast<int>(corners[0]), static_cast<int>(corners[k]), static_cast<int>(corners[k + 1])});
+}
+
+Eigen::Vector3d checked_point(double x, double y, double z, const std::string& path, long line) {
+  const Eigen::Vector3d p(x, y, z);
+  if (!p.allFinite()) input_error(path, line, "non-finite vertex coordinate");
+  return p;
+}
+
+// Tokens of a text file with the line each came from; '#' starts a comment.
+struct Tokens {
+  std::vector<std::string> words;
+  std::vector<long> lines;
+  size_t next = 0;
+  const std::string* path = nullptr;
+  bool done() const { return next >= words.size(); }
+  long line() const { return next < lines.size() ? lines[next] : (lines.empty() ? 0 : lines.back()); }
+  const std::string& word() {
+    if (done()) input_error(*path, line(), "unexpected end of file");
+    return words[next++];
+  }
+  double number() {
+    const long at = line();
+    const std::string& w = word();
+    char* end = nullptr;
+    const double v = std::strtod(w.c_str(), &end);
+    if (end != w.c_str() + w.size()) input_error(*path, at, "expected a number, found '" + w + "'");
+    return v;
+  }
+  long integer() {
+    const double v = number();
+    if (v != std::floor(v)) input_error(*path, line(), "expected an integer");
+    return static_cast<long>(v);
+  }
+};
+
+Tokens tokenize(const std::string& text, const std::string& path) {
+  Tokens t;
+  t.path = &path;
+  std::istringstream in(text);
+  std::string line;
+  long number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream words(line);
+    std::string w;
+    while (words >> w) t.words.push_back(w), t.lines.push_back(number);
+  }
+  return t;
+}
+
+// Calls visit(line number, first word, the rest of the line's words) for
+// every line that has a first word.
+template <class Visit>
+void for_each_tagged_line(const std::string& text, Visit visit) {
+  std::istringstream in(text);
+  std::string line;
+  long number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    std::istringstream words(line);
+    std::string tag;
+    if (words >> tag) visit(number, tag, words);
+  }
+}
+
+SurfaceMesh read_off(const std::string& path) {
+  const std::string text = read_all(path);
+  Tokens t = tokenize(text, path);
+  std::string head = t.word();
+  if (head != "OFF" && head != "COFF" && head != "NOFF") input_error(path, 1, "not an OFF file (header '" + head + "')");
+  const long nv = t.integer(), nf = t.integer();
+  t.integer();  // edges
+  if (nv < 0 || nf < 0) input_error(path, t.line(), "negative element count");
+  SurfaceMesh mesh;
+  for (long i = 0; i < nv; ++i) {
+    const long at = t.line();
+    const double x = t.number(), y = t.number(), z = t.number();
+    mesh.vertices.push_back(checked_point(x, y, z, path, at));
+    // COFF/NOFF carry more numbers on the line.
+    while (!t.done() && t.lines[t.next] == at) t.word();
+  }
+  for (long f = 0; f < nf; ++f) {
+    const long at = t.line();
+    const long n = t.integer();
+    std::vector<long> corners;
+    for (long k = 0; k < n; ++k) corners.push_back(t.integer());
+    add_polygon(mesh, corners, path, at);
+    while (!t.done() && t.lines[t.next] == at) t.word();  // face colours
+  }
+  return mesh;
+}
+
+SurfaceMesh read_obj(const std::string& path) {
+  SurfaceMesh mesh;
+  for_each_tagged_line(read_all(path), [&](long number, const std::string& tag, std::istringstream& words) {
+    if (tag == "v") {
+      double x, y, z;
+      if (!(words >> x >> y >> z)) input_error(path, number, "vertex needs x y z");
+      mesh.vertices.push_back(checked_point(x, y, z, path, number));
+    } else if (tag == "f") {
+      std::vector<long> corners;
+      std::string corner;
+      while (words >> corner) {
+        const long index = std::strtol(corner.c_str(), nullptr, 10);  // "7/3/2" -> 7
+        if (index == 0) input_error(path, number, "bad face corner '" + corner + "'");
+        corners.push_back(index > 0 ? index - 1 : static_cast<long>(mesh.vertices.size()) + index);
+      }
+      add_polygon(mesh, corners, path, number);
+    }
+  });
+  return mesh;
+}
+
+// STL stores corners per triangle; identical coordinates become one vertex.
+struct VertexMerger {
+  std::map<std::array<double, 3>, int> index;
+  int operator()(SurfaceMesh& mesh, const Eigen::Vector3d& p) {
+    auto [it, inserted] = index.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(mesh.vertices.size()));
+    if (inserted) mesh.vertices.push_back(p);
+    return it->second;
+  }
+};
+
+SurfaceMesh read_stl(const std::string& path) {
+  const std::string data = read_all(path);
+  SurfaceMesh mesh;
+  VertexMerger merge;
+  const bool ascii = data.compare(0, 5, "solid") == 0 && data.find("facet") != std::string::npos;
+  if (!ascii) {
+    if (data.size() < 84) input_error(path, 0, "binary STL shorter than its 84-byte header");
+    uint32_t count = 0;
+    std::memcpy(&count, data.data() + 80, 4);
+    if (data.size() < 84 + 50ull * count)
+      input_error(path, 0, "binary STL announces " + std::to_string(count) + " triangles but is too short");
+    for (uint32_t f = 0; f < count; ++f) {
+      const char* rec = data.data() + 84 + 50ull * f + 12;
+      std::array<int, 3> tri{};
+      for (int k = 0; k < 3; ++k) {
+        float c[3];
+        std::memcpy(c, rec + 12 * k, 12);
+        tri[k] = merge(mesh, checked_point(c[0], c[1], c[2], path, 0));
+      }
+      mesh.triangles.push_back(tri);
+    }
+    return mesh;
+  }
+  std::istringstream in(data);
+  std::string line;
+  long number = 0;
+  std::vector<int> corners;
+  while (std::getline(in, line)) {
+    ++number;
+    std::istringstream words(line);
+    std::string tag;
+    words >> tag;
+    if (tag == "vertex") {
+      double x, y, z;
+      if (!(words >> x >> y >> z)) input_error(path, number, "vertex needs x y z");
+      corners.push_back(merge(mesh, checked_point(x, y, z, path, number)));
+    } else if (tag == "endfacet") {
+      if (corners.size() != 3) input_error(path, number, "facet without exactly 3 vertices");
+      mesh.triangles.push_back({corners[0], corners[1], corners[2]});
+      corners.clear();
+    }
+  }
+  return mesh;
+}
+
+SurfaceMesh read_ply(const std::string& path) {
+  const std::string data = read_all(path);
+  const size_t end_header = data.find("end_header");
+  if (data.compare(0, 3, "ply") != 0 || end_header == std::string::npos) input_error(path, 1, "not a PLY file");
+  size_t body = data.find('\n', end_header);
+  body = body == std::string::npos ? data.size() : body + 1;
+  struct Property {
+    std::string name, type, count_type;  // count_type non-empty for lists
+  };
+  struct Element {
+    std::string name;
+    long count = 0;
+    std::vector<Property> properties;
+  };
+  std::vector<Element> elements;
+  std::string format;
+  for_each_tagged_line(data.substr(0, end_header), [&](long number, const std::string& tag, std::istringstream& w) {
+    if (tag == "format") {
+      w >> format;
+    } else if (tag == "element") {
+      Element e;
+      w >> e.name >> e.count;
+      elements.push_back(e);
+    } else if (tag == "property") {
+      if (elements.empty()) input_error(path, number, "property before any element");
+      Property p;
+      w >> p.type;
+      if (p.type == "list") w >> p.count_type >> p.type;
+      w >> p.name;
+      elements.back().properties.push_back(p);
+    }
+  });
+  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+    input_error(path, 2, "unknown PLY format '" + format + "'");
+  const bool ascii = format == "ascii";
+  const bool swap = format == "binary_big_endian";
+  auto size_of = [&](const std::string& t) -> size_t {
+    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+    if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
+    if (t == "double" || t == "float64") return 8;
+    input_error(path, 0, "unknown PLY property type '" + t + "'");
+  };
+  size_t pos = body;
+  std::istringstream text(ascii ? data.substr(body) : std::string());
+  auto read_value = [&](const std::string& type) -> double {
+    if (ascii) {
+      double v;
+      if (!(text >> v)) input_error(path, 0, "PLY body ends early or holds a non-number");
+      return v;
+    }
+    const size_t n = size_of(type);
+    if (pos + n > data.size()) input_error(path, 0, "PLY body ends early");
+    unsigned char b[8];
+    std::memcpy(b, data.data() + pos, n);
+    pos += n;
+    if (swap) std::reverse(b, b + n);
+    if (type == "float" || type == "float32") { float f; std::memcpy(&f, b, 4); return f; }
+    if (type == "double" || type == "float64") { double d; std::memcpy(&d, b, 8); return d; }
+    if (type == "char" || type == "int8") return static_cast<int8_t>(b[0]);
+    if (type == "uchar" || type == "uint8") return b[0];
+    if (type == "short" || type == "int16") { int16_t v; std::memcpy(&v, b, 2); return v; }
+    if (type == "ushort" || type == "uint16") { uint16_t v; std::memcpy(&v, b, 2); return v; }
+    if (type == "int" || type == "int32") { int32_t v; std::memcpy(&v, b, 4); return v; }
+    uint32_t v;
+    std::memcpy(&v, b, 4);
+    return v;
+  };
+  SurfaceMesh mesh;
+  for (const Element& e : elements) {
+    for (long i = 0; i < e.count; ++i) {
+      double xyz[3] = {NAN, NAN, NAN};
+      std::vector<long> corners;
+      for (const Property& p : e.properties) {
+        if (!p.count_type.empty()) {
+          const long n = static_cast<long>(read_value(p.count_type));
+          for (long k = 0; k < n; ++k) {
+            const double v = read_value(p.type);
+            if (e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index")) corners.push_back(static_cast<long>(v));
+          }
+        } else {
+          const double v = read_value(p.type);
+          if (e.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z")) xyz[p.name[0] - 'x'] = v;
+        }
+      }
+      if (e.name == "vertex") mesh.vertices.push_back(checked_point(xyz[0], xyz[1], xyz[2], path, 0));
+      if (e.name == "face") add_polygon(mesh, corners, path, 0);
+    }
+  }
+  return mesh;
+}
+
+// MSMS: NAME.vert (header lines starting with '#', a count line, then
+// "x y z nx ny nz ..." per vertex) and NAME.face ("v1 v2 v3 ..." 1-based).
+SurfaceMesh read_msms(const std::string& path) {
+  const std::string stem = path.substr(0, path.size() - 5);
+  const std::string vert = stem + ".vert", face = stem + ".face";
+  SurfaceMesh mesh;
+  auto data_lines = [](const std::string& file, auto visit) {
+    std::istringstream in(read_all(file));
+    std::string line;
+    long number = 0;
+    bool count_seen = false;
+    while (std::getline(in, line)) {
+      ++number;
+      if (line.empty() || line[0] == '#') continue;
+      if (!count_seen) {
+        count_seen = true;  // "count  spheres  density  probe"
+        continue;
+      }
+      visit(number, line);
+    }
+  };
+  data_lines(vert, [&](long number, const std::string& line) {
+    std::istringstream w(line);
+    double x, y, z, nx, ny, nz;
+    if (!(w >> x >> y >> z)) input_error(vert, number, "vertex line needs x y z");
+    mesh.vertices.push_back(checked_point(x, y, z, vert, number));
+    if (w >> nx >> ny >> nz) mesh.normals.emplace_back(nx, ny, nz);
+  });
+  if (mesh.normals.size() != mesh.vertices.size()) mesh.normals.clear();
+  data_lines(face, [&](long number, const std::string& line) {
+    std::istringstream w(line);
+    long a, b, c;
+    if (!(w >> a >> b >> c)) input_error(face, number, "face line needs three vertex numbers");
+    add_polygon(mesh, {a - 1, b - 1, c - 1}, face, number);
+  });
+  return mesh;
+}
+
+// Gmsh MSH 4.x ASCII: the nodes of every entity block; triangles (type 2)
+// and quadrangles (type 3) with their entity tags, and tetrahedra (type 4)
+// with theirs; other element types (points, lines, other volumes) are skipped.
+struct GmshContent {
+  SurfaceMesh surface;
+  std::vector<int> triangle_entity;
+  std::vector<std::array<int, 4>> tets;
+  std::vector<int> tet_entity;
+};
+
+GmshContent read_gmsh_content(const std::string& path) {
+  const std::string text = read_all(path);
+  Tokens t = tokenize(text, path);
+  auto seek = [&](const char* section) {
+    while (!t.done() && t.words[t.next] != section) ++t.next;
+    if (t.done()) input_error(path, 0, std::string("no ") + section + " section");
+    ++t.next;
+  };
+  seek("$MeshFormat");
+  const long at = t.line();
+  const std::string version = t.word();
+  if (version.rfind("4", 0) != 0) input_error(path, at, "Gmsh format " + version + " (only 4.x is read)");
+  if (t.integer() != 0) input_error(path, at, "binary Gmsh files are not read (save as ASCII)");
+  t.next = 0;
+  seek("$Nodes");
+  GmshContent out;
+  SurfaceMesh& mesh = out.surface;
+  std::map<long, int> index;
+  const long node_blocks = t.integer();
+  t.integer();  // number of nodes
+  t.integer();  // smallest tag
+  t.integer();  // largest tag
+  for (long b = 0; b < node_blocks; ++b) {
+    t.integer();  // entity dimension
+    t.integer();  // entity tag
+    const long parametric = t.integer(), count = t.integer();
+    std::vector<long> tags;
+    for (long i = 0; i < count; ++i) tags.push_back(t.integer());
+    for (long i = 0; i < count; ++i) {
+      const long line = t.line();
+      const double x = t.number(), y = t.number(), z = t.number();
+      if (parametric) while (!t.done() && t.lines[t.next] == line) t.word();
+      index[tags[static_cast<size_t>(i)]] = static_cast<int>(mesh.vertices.size());
+      mesh.vertices.push_back(checked_point(x, y, z, path, line));
+    }
+  }
+  seek("$Elements");
+  const long element_blocks = t.integer();
+  t.integer();
+  t.integer();
+  t.integer();
+  const std::map<long, int> corners_of{{15, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 4}, {5, 8}, {6, 6}, {7, 5}};
+  for (long b = 0; b < element_blocks; ++b) {
+    t.integer();  // entity dimension
+    const long entity = t.integer();
+    const long block_line = t.line();
+    const long type = t.integer(), count = t.integer();
+    const auto known = corners_of.find(type);
+    if (known == corners_of.end()) input_error(path, block_line, "unsupported Gmsh element type " + std::to_string(type));
+    for (long e = 0; e < count; ++e) {
+      const long line = t.line();
+      t.integer();  // element tag
+      std::vector<long> corners;
+      for (int k = 0; k < known->second; ++k) {
+        const long tag = t.integer();
+        const auto it = index.find(tag);
+        if (it == index.end()) input_error(path, line, "element refers to node " + std::to_string(tag) + ", not in $Nodes");
+        corners.push_back(it->second);
+      }
+      if (type == 2 || type == 3) {
+        add_polygon(mesh, corners, path, line);
+        out.triangle_entity.resize(mesh.triangles.size(), static_cast<int>(entity));
+      } else if (type == 4) {
+        out.tets.push_back({static_cast<int>(corners[0]), static_cast<int>(corners[1]), static_cast<int>(corners[2]),
+                            static_cast<int>(corners[3])});
+        out.tet_entity.push_back(static_cast<int>(entity));
+      }
+    }
+  }
+  return out;
+}
+
+SurfaceMesh read_gmsh(const std::string& path) { return read_gmsh_content(path).surface; }
+
+// `count` node numbers of one TetGen item, shifted to zero-based and checked.
+template <size_t count>
+std::array<int, count> tetgen_corners(Tokens& t, long first, long nodes, const std::string& path, long line,
+                                      const char* what) {
+  std::array<int, count> out{};
+  for (size_t k = 0; k < count; ++k) {
+    const long v = t.integer() - first;
+    if (v < 0 || v >= nodes) input_error(path, line, std::string(what) + " refers to node " + std::to_string(v + first));
+    out[k] = static_cast<int>(v);
+  }
+  return out;
+}
+
+// TetGen's files: "<count> <fields...>" headers, one numbered item a line,
+// '#' comments; `stem` is the name without .node/.ele/.face.
+TetMesh read_tetgen(const std::string& stem) {
+  TetMesh mesh;
+  {
+    const std::string path = stem + ".node";
+    Tokens t = tokenize(read_all(path), path);
+    const long n = t.integer(), dim = t.integer(), attributes = t.integer(), markers = t.integer();
+    if (dim != 3) input_error(path, 1, "not a 3D .node file");
+    if (n < 0 || attributes < 0 || markers < 0) input_error(path, 1, "negative count");
+    std::vector<long> numbers;
+    for (long i = 0; i < n; ++i) {
+      const long line = t.line();
+      numbers.push_back(t.integer());
+      const double x = t.number(), y = t.number(), z = t.number();
+      mesh.points.push_back(checked_point(x, y, z, path, line));
+      for (long k = 0; k < attributes + markers; ++k) t.number();
+    }
+    // Indices may start at 0 or 1 (TetGen keeps the input's numbering).
+    const long first = numbers.empty() ? 0 : *std::min_element(numbers.begin(), numbers.end());
+    if (first != 0 && first != 1) input_error(path, 2, "node numbers start at " + std::to_string(first));
+    const std::string ele = stem + ".ele";
+    Tokens e = tokenize(read_all(ele), ele);
+    const long m = e.integer(), corners = e.integer(), ele_attributes = e.integer();
+    if (corners != 4) input_error(ele, 1, "only 4-node tetrahedra are read");
+    for (long i = 0; i < m; ++i) {
+      const long line = e.line();
+      e.integer();
+      mesh.tets.push_back(tetgen_corners<4>(e, first, n, ele, line, "tetrahedron"));
+      double region = 0;
+      for (long k = 0; k < ele_attributes; ++k) {
+        const double a = e.number();
+        if (k == 0) region = a;
+      }
+      mesh.tet_region.push_back(static_cast<int>(std::lround(region)));
+    }
+    const std::string face = stem + ".face";
+    if (std::ifstream(face).good()) {
+      Tokens f = tokenize(read_all(face), face);
+      const long nf = f.integer(), with_markers = f.integer();
+      for (long i = 0; i < nf; ++i) {
+        const long line = f.line();
+        f.integer();
+        mesh.faces.push_back(tetgen_corners<3>(f, first, n, face, line, "face"));
+        mesh.face_marker.push_back(with_markers ? static_cast<int>(f.integer()) : 0);
+      }
+    }
+  }
+  return mesh;
+}
+
+}  // namespace
+
+SurfaceMesh read_surface_mesh(const std::string& path) {
+  SurfaceMesh mesh;
+  if (has_extension(path, ".off")) mesh = read_off(path);
+  else if (has_extension(path, ".obj")) mesh = read_obj(path);
+  else if (has_extension(path, ".stl")) mesh = read_stl(path);
+  else if (has_extension(path, ".ply")) mesh = read_ply(path);
+  else if (has_extension(path, ".vert") || has_extension(path, ".face")) mesh = read_msms(path);
+  else if (has_extension(path, ".msh")) mesh = read_gmsh(path);
+  else input_error(path, 0, "unknown mesh format (expected .off, .obj, .stl, .ply, .msh, or an MSMS .vert/.face pair)");
+  if (mesh.triangles.empty()) input_error(path, 0, "mesh has no triangles");
+  return mesh;
+}
+
+TetMesh read_gmsh_volume(const std::string& path) {
+  GmshContent g = read_gmsh_content(path);
+  TetMesh mesh;
+  mesh.points = std::move(g.surface.vertices);
+  mesh.tets = std::move(g.tets);
+  mesh.tet_region = std::move(g.tet_entity);
+  mesh.faces = std::move(g.surface.triangles);
+  mesh.face_marker = std::move(g.triangle_entity);
+  return mesh;
+}
+
+TetMesh read_tet_mesh(const std::string& path) {
+  for (const char* ext : {".node", ".ele", ".face"})
+    if (has_extension(path, ext)) return read_tetgen(path.substr(0, path.size() - std::string(ext).size()));
+  if (!has_extension(path, ".msh")) input_error(path, 0, "unknown volume mesh format (expected .ele/.node/.face or .msh)");
+  TetMesh mesh = read_gmsh_volume(path);
+  if (mesh.tets.empty()) input_error(path, 0, "no tetrahedra in the file");
+  return mesh;
+}
+
+}  // namespace skinmesh

@@ -1,0 +1,229 @@
+#include "skinmesh/mesh_io/mesh_write.hpp"
+#include "skinmesh/core/error.hpp"
+
+#include "skinmesh/core/file_names.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <cstring>
+#include <iomanip>
+#include <stdexcept>
+
+namespace skinmesh {
+namespace {
+
+int digits(const MeshWriteOptions& o) { return o.single_precision ? 9 : 17; }
+
+Eigen::Vector3d normal_of(const SurfaceMesh& mesh, size_t v) {
+  return v < mesh.normals.size() ? mesh.normals[v] : Eigen::Vector3d::Zero();
+}
+
+bool has(const VertexAttributes* a, const SurfaceMesh& mesh) {
+  return a && a->patch.size() == mesh.vertices.size() && a->atom.size() == mesh.vertices.size();
+}
+
+template <class T>
+void put(std::ostream& out, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));  // little endian on every machine we build for (checked below)
+  out.write(bytes, sizeof(T));
+}
+
+void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
+               const MeshWriteOptions& options) {
+  static_assert(sizeof(float) == 4 && sizeof(double) == 8, "IEEE floating point expected");
+  const uint16_t probe = 1;
+  if (*reinterpret_cast<const uint8_t*>(&probe) != 1) contract_error("the PLY writer needs a little-endian host");
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  const bool attrs = has(attributes, mesh);
+  const char* real = options.single_precision ? "float" : "double";
+  out << "ply\nformat binary_little_endian 1.0\ncomment skinmesh: molecular skin surface\n";
+  out << "element vertex " << mesh.vertices.size() << "\n";
+  for (const char* c : {"x", "y", "z"}) out << "property " << real << " " << c << "\n";
+  if (normals)
+    for (const char* c : {"nx", "ny", "nz"}) out << "property " << real << " " << c << "\n";
+  if (attrs) out << "property uchar patch\nproperty int atom\n";
+  out << "element face " << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  auto real_out = [&](double v) {
+    if (options.single_precision)
+      put(out, static_cast<float>(v));
+    else
+      put(out, v);
+  };
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    for (int k = 0; k < 3; ++k) real_out(mesh.vertices[v][k]);
+    if (normals)
+      for (int k = 0; k < 3; ++k) real_out(mesh.normals[v][k]);
+    if (attrs) {
+      put(out, static_cast<uint8_t>(attributes->patch[v]));
+      put(out, static_cast<int32_t>(attributes->atom[v]));
+    }
+  }
+  for (const auto& t : mesh.triangles) {
+    put(out, static_cast<uint8_t>(3));
+    for (int k = 0; k < 3; ++k) put(out, static_cast<int32_t>(t[static_cast<size_t>(k)]));
+  }
+}
+
+void write_off(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+  out << "OFF\n" << mesh.vertices.size() << " " << mesh.triangles.size() << " 0\n" << std::setprecision(digits(options));
+  for (const auto& v : mesh.vertices) out << v[0] << " " << v[1] << " " << v[2] << "\n";
+  for (const auto& t : mesh.triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+}
+
+void write_obj(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  out << "# skinmesh: molecular skin surface\n" << std::setprecision(digits(options));
+  for (const auto& v : mesh.vertices) out << "v " << v[0] << " " << v[1] << " " << v[2] << "\n";
+  if (normals)
+    for (const auto& n : mesh.normals) out << "vn " << n[0] << " " << n[1] << " " << n[2] << "\n";
+  for (const auto& t : mesh.triangles) {
+    out << "f";
+    for (int k = 0; k < 3; ++k) {
+      const int i = t[static_cast<size_t>(k)] + 1;
+      out << " " << i;
+      if (normals) out << "//" << i;
+    }
+    out << "\n";
+  }
+}
+
+// Binary STL holds 32-bit floats only, whatever the options say.
+void write_stl(std::ostream& out, const SurfaceMesh& mesh) {
+  char header[80] = {};
+  std::strncpy(header, "skinmesh: molecular skin surface (binary STL, single precision)", sizeof(header) - 1);
+  out.write(header, sizeof(header));
+  put(out, static_cast<uint32_t>(mesh.triangles.size()));
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
+    const Eigen::Vector3d& b = mesh.vertices[static_cast<size_t>(t[1])];
+    const Eigen::Vector3d& c = mesh.vertices[static_cast<size_t>(t[2])];
+    const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+    for (int k = 0; k < 3; ++k) put(out, static_cast<float>(n[k]));
+    for (const Eigen::Vector3d* p : {&a, &b, &c})
+      for (int k = 0; k < 3; ++k) put(out, static_cast<float>((*p)[k]));
+    put(out, static_cast<uint16_t>(0));
+  }
+}
+
+// VTK XML PolyData, ASCII: opens in ParaView with normals and attributes.
+void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
+               const MeshWriteOptions& options) {
+  const char* real = options.single_precision ? "Float32" : "Float64";
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<PolyData>\n<Piece NumberOfPoints=\"" << mesh.vertices.size() << "\" NumberOfPolys=\""
+      << mesh.triangles.size() << "\">\n"
+      << std::setprecision(digits(options));
+  out << "<Points>\n<DataArray type=\"" << real << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& v : mesh.vertices) out << v[0] << " " << v[1] << " " << v[2] << "\n";
+  out << "</DataArray>\n</Points>\n<PointData";
+  if (mesh.normals.size() == mesh.vertices.size()) out << " Normals=\"Normals\"";
+  out << ">\n";
+  if (mesh.normals.size() == mesh.vertices.size()) {
+    out << "<DataArray type=\"" << real << "\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (const auto& n : mesh.normals) out << n[0] << " " << n[1] << " " << n[2] << "\n";
+    out << "</DataArray>\n";
+  }
+  if (has(attributes, mesh)) {
+    for (const auto& [name, values] : {std::pair<const char*, const std::vector<int>*>{"patch", &attributes->patch},
+                                       {"atom", &attributes->atom}}) {
+      out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (int v : *values) out << v << "\n";
+      out << "</DataArray>\n";
+    }
+  }
+  out << "</PointData>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const auto& t : mesh.triangles) out << t[0] << " " << t[1] << " " << t[2] << "\n";
+  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) out << 3 * (i + 1) << "\n";
+  out << "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+}
+
+}  // namespace
+
+// Gmsh MSH 4.1 ASCII: one surface entity, physical group 1 named "skin".
+void write_gmsh_surface(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (const auto& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  if (mesh.vertices.empty()) lo = hi = Eigen::Vector3d::Zero();
+  out << std::setprecision(digits(options));
+  out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"skin\"\n$EndPhysicalNames\n";
+  out << "$Entities\n0 0 1 0\n1 " << lo[0] << ' ' << lo[1] << ' ' << lo[2] << ' ' << hi[0] << ' ' << hi[1] << ' '
+      << hi[2] << " 1 1 0\n$EndEntities\n";
+  const size_t n = mesh.vertices.size(), m = mesh.triangles.size();
+  out << "$Nodes\n1 " << n << " 1 " << n << "\n2 1 0 " << n << "\n";
+  for (size_t i = 0; i < n; ++i) out << i + 1 << "\n";
+  for (const auto& v : mesh.vertices) out << v[0] << ' ' << v[1] << ' ' << v[2] << "\n";
+  out << "$EndNodes\n$Elements\n1 " << m << " 1 " << m << "\n2 1 2 " << m << "\n";
+  for (size_t i = 0; i < m; ++i) {
+    const auto& t = mesh.triangles[i];
+    out << i + 1 << ' ' << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << "\n";
+  }
+  out << "$EndElements\n";
+}
+
+MeshFormat mesh_format_from_path(const std::string& path) {
+  if (has_extension(path, ".ply")) return MeshFormat::ply;
+  if (has_extension(path, ".off")) return MeshFormat::off;
+  if (has_extension(path, ".obj")) return MeshFormat::obj;
+  if (has_extension(path, ".stl")) return MeshFormat::stl;
+  if (has_extension(path, ".vtp")) return MeshFormat::vtp;
+  if (has_extension(path, ".vert")) return MeshFormat::msms;
+  if (has_extension(path, ".msh")) return MeshFormat::gmsh;
+  contract_error(path + ": unknown mesh format (use .ply, .off, .obj, .stl, .vtp, .msh, or .vert for MSMS)");
+}
+
+const char* mesh_format_name(MeshFormat format) {
+  switch (format) {
+    case MeshFormat::ply: return "ply";
+    case MeshFormat::off: return "off";
+    case MeshFormat::obj: return "obj";
+    case MeshFormat::stl: return "stl";
+    case MeshFormat::vtp: return "vtp";
+    case MeshFormat::msms: return "msms";
+    case MeshFormat::gmsh: return "gmsh";
+  }
+  return "?";
+}
+
+void write_mesh(std::ostream& out, const SurfaceMesh& mesh, MeshFormat format, const VertexAttributes* attributes,
+                const MeshWriteOptions& options) {
+  switch (format) {
+    case MeshFormat::ply: write_ply(out, mesh, attributes, options); break;
+    case MeshFormat::off: write_off(out, mesh, options); break;
+    case MeshFormat::gmsh: write_gmsh_surface(out, mesh, options); break;
+    case MeshFormat::obj: write_obj(out, mesh, options); break;
+    case MeshFormat::stl: write_stl(out, mesh); break;
+    case MeshFormat::vtp: write_vtp(out, mesh, attributes, options); break;
+    case MeshFormat::msms: contract_error("MSMS is two files: use write_msms_vert and write_msms_face");
+  }
+  if (!out) output_error("", "writing the mesh failed");
+}
+
+void write_msms_vert(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
+                     const MeshWriteOptions& options) {
+  const bool attrs = has(attributes, mesh);
+  out << "# MSMS-format vertices written by skinmesh (molecular skin surface)\n"
+      << "#vertex #sphere density probe_r\n"
+      << mesh.vertices.size() << " " << 0 << " " << 0 << " " << 0 << "\n"
+      << std::setprecision(digits(options));
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Eigen::Vector3d& p = mesh.vertices[v];
+    const Eigen::Vector3d n = normal_of(mesh, v);
+    out << p[0] << " " << p[1] << " " << p[2] << " " << n[0] << " " << n[1] << " " << n[2] << " 0 "
+        << (attrs ? attributes->patch[v] : 0) << " " << (attrs ? attributes->atom[v] + 1 : 0) << "\n";
+  }
+  if (!out) output_error("", "writing the MSMS vertices failed");
+}
+
+void write_msms_face(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes) {
+  (void)attributes;
+  out << "# MSMS-format triangles written by skinmesh (molecular skin surface)\n"
+      << "#faces #sphere density probe_r\n"
+      << mesh.triangles.size() << " 0 0 0\n";
+  for (const auto& t : mesh.triangles) out << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << " 1 1\n";
+  if (!out) output_error("", "writing the MSMS triangles failed");
+}
+
+}  // namespace skinmesh

@@ -1,0 +1,205 @@
+// The restricted Delaunay refiner behind mesh_skin (private to meshing/):
+// the 3D Delaunay triangulation of the samples, what its facets say about the
+// skin, and the refinement and clean-up that change it. Included by
+// skin_mesher.cpp (refinement) and edge_contraction.cpp (clean-up) only.
+#pragma once
+
+#include "skinmesh/mesher/skin_mesher.hpp"
+
+#include "skinmesh/core/stopwatch.hpp"
+
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_cell_base_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <Eigen/Geometry>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <queue>
+#include <tuple>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace skinmesh::detail {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+struct VertexInfo {
+  int cell = -1;  // mixed cell of the sample (a hint for every walk that starts near it)
+  int id = -1;    // insertion order
+};
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<VertexInfo, K>;
+// Cell info: a stamp that changes whenever the cell is (re)created, so that an
+// evaluation of a facet can tell whether its Voronoi edge is still the same.
+// A cell made by the triangulation itself (a vertex removal) starts as
+// kFreshCell until the refiner stamps it.
+constexpr unsigned kFreshCell = std::numeric_limits<unsigned>::max();
+struct CellStamp {
+  unsigned value = kFreshCell;
+};
+using Cb = CGAL::Triangulation_cell_base_with_info_3<CellStamp, K, CGAL::Delaunay_triangulation_cell_base_3<K>>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
+using Delaunay = CGAL::Delaunay_triangulation_3<K, Tds>;
+using Vertex_handle = Delaunay::Vertex_handle;
+using Cell_handle = Delaunay::Cell_handle;
+using Facet = Delaunay::Facet;
+
+inline Eigen::Vector3d to_eigen(const K::Point_3& p) { return {p.x(), p.y(), p.z()}; }
+
+// What the Voronoi edge dual to one Delaunay facet says about it.
+struct FacetEval {
+  int crossings = 0;                 // of the Voronoi edge with the skin; restricted iff > 0
+  Eigen::Vector3d center;            // surface Delaunay ball centre (farthest crossing if several)
+  int cell = -1;                     // its mixed cell
+  double radius = 0;                 // surface Delaunay ball radius
+  Eigen::Vector3d outward;           // outward skin normal direction along the Voronoi edge
+  TriangleDefect defect = TriangleDefect::none;
+  bool force = false;                // a vertex-star repair: insert even without a defect
+  std::array<Vertex_handle, 3> v;
+  unsigned stamp_c = 0, stamp_n = 0; // of the two cells when evaluated
+};
+
+// Whether the link of a vertex (the opposite edges of its restricted
+// triangles) is one closed cycle: the vertex star is a disk.
+bool is_single_cycle(const std::vector<std::pair<int, int>>& edges);
+
+// A facet by its vertices' ids, ascending: the same key whichever cell the
+// facet is reached from.
+using FacetKey = std::array<int, 3>;
+inline FacetKey facet_key(FacetKey ids) {
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+inline FacetKey facet_key(const Facet& f) {
+  FacetKey ids;
+  for (int k = 0; k < 3; ++k) ids[static_cast<size_t>(k)] = f.first->vertex((f.second + 1 + k) & 3)->info().id;
+  return facet_key(ids);
+}
+inline FacetKey facet_key(const FacetEval& e) {
+  return facet_key({e.v[0]->info().id, e.v[1]->info().id, e.v[2]->info().id});
+}
+struct FacetKeyHash {
+  size_t operator()(const FacetKey& k) const {
+    size_t h = static_cast<size_t>(k[0]);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<size_t>(k[1]);
+    return h * 0x9E3779B97F4A7C15ull ^ static_cast<size_t>(k[2]);
+  }
+};
+using FacetSet = std::unordered_set<FacetKey, FacetKeyHash>;
+
+// The link of a vertex in the restricted triangles: the edges opposite it,
+// by vertex ids. Its star is a disk when they form one cycle.
+using Links = std::unordered_map<int, std::vector<std::pair<int, int>>>;
+enum class LinkScope { listed_vertices, every_vertex };
+// Adds to each corner's link the edge of triangle `ids` opposite it; with
+// listed_vertices only to corners already in `links`.
+inline void add_to_links(const FacetKey& ids, LinkScope scope, Links& links) {
+  for (size_t k = 0; k < 3; ++k) {
+    auto it = links.find(ids[k]);
+    if (it == links.end()) {
+      if (scope == LinkScope::listed_vertices) continue;
+      it = links.emplace(ids[k], std::vector<std::pair<int, int>>{}).first;
+    }
+    it->second.emplace_back(ids[(k + 1) % 3], ids[(k + 2) % 3]);
+  }
+}
+
+// How the refiner reports progress: at once, or at most every quarter second.
+enum class Report { now, throttled };
+
+// Refinement cannot go on (over budget, stalled, unrepairable): thrown inside
+// the refiner and turned into the result's status by mesh_skin.
+struct RefinementStopped {
+  MeshingStatus status;
+  std::string message;
+};
+
+class Refiner {
+ public:
+  Refiner(const SkinComplex& complex, const MeshingOptions& options) : complex_(complex), options_(options) {
+    // The skin lies inside the union of the input balls: rays beyond this box miss it.
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    double max_radius = 0;
+    for (const Ball& b : complex.balls()) {
+      lo = lo.cwiseMin(b.center);
+      hi = hi.cwiseMax(b.center);
+      max_radius = std::max(max_radius, std::sqrt(std::max(0.0, b.weight)));
+    }
+    box_center_ = 0.5 * (lo + hi);
+    box_radius_ = 0.5 * (hi - lo).norm() + max_radius + 1.0;
+    max_radius_edge_ = 1.0 / (2.0 * std::sin(options.min_angle * M_PI / 180.0));
+  }
+
+  SkinMeshResult run();
+
+ private:
+  // Calls visit(facet, key) once for every finite facet with a vertex in
+  // `region`, until visit returns false.
+  template <class Visit>
+  void for_each_facet_around(const std::vector<Vertex_handle>& region, Visit visit) const {
+    FacetSet seen;
+    std::vector<Facet> facets;
+    for (const Vertex_handle& w : region) {
+      facets.clear();
+      dt_.finite_incident_facets(w, std::back_inserter(facets));
+      for (const Facet& f : facets) {
+        const FacetKey key = facet_key(f);
+        if (seen.insert(key).second && !visit(f, key)) return;
+      }
+    }
+  }
+
+  FacetEval evaluate(const Facet& facet) const;
+  void insert_seeds();
+  Vertex_handle insert(const Eigen::Vector3d& p, int cell, Cell_handle hint);
+  void push_if_bad(const FacetEval& e);
+  void push_repair(FacetEval e);  // a vertex-star repair: insert its ball centre even without a defect
+  void refine();
+  std::vector<Facet> star_facets(Vertex_handle v) const;  // after insert(v)
+  std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
+  bool global_pass(std::vector<FacetEval>* restricted);
+  bool repair_stars(const std::vector<FacetEval>& restricted, const std::vector<Vertex_handle>& vertices);
+  void local_passes();
+  SurfaceMesh extract(const std::vector<FacetEval>& restricted) const;
+  void report(const char* stage, Report when, long pending = 0);
+  void refine_until_clean(std::vector<FacetEval>* restricted);
+
+  // Clean-up (edge_contraction.cpp).
+  long contract_short_edges(const std::vector<FacetEval>& restricted);
+  bool try_contract(Vertex_handle a, Vertex_handle b, const Projection& target, unsigned pass_stamp,
+                    const FacetSet& restricted_before, std::unordered_set<int>* touched);
+  bool region_is_good(const std::vector<Vertex_handle>& region, unsigned pass_stamp,
+                      const FacetSet& restricted_before) const;
+  Vertex_handle reinsert(const Eigen::Vector3d& p, const VertexInfo& info, Cell_handle hint);
+  void stamp_fresh_cells(const std::vector<Vertex_handle>& vertices);  // around these vertices
+  void check_budget() const;
+
+  const SkinComplex& complex_;
+  const MeshingOptions& options_;
+  Delaunay dt_;
+  std::vector<FacetEval> pending_;   // bad facets waiting for their surface ball centre
+  std::vector<Cell_handle> star_;    // cells made by the last insertion
+  std::vector<Vertex_handle> recent_;  // inserted since the last global or local pass
+  unsigned stamp_ = 0;
+  // The restricted facets of the last global pass, by vertex ids, and the
+  // stamp then: cells stamped no later are unchanged since.
+  std::unordered_map<FacetKey, FacetEval, FacetKeyHash> pass_cache_;
+  unsigned last_pass_stamp_ = 0;
+  bool have_pass_cache_ = false;
+  Eigen::Vector3d box_center_;
+  double box_radius_ = 0;
+  double max_radius_edge_ = 1;
+  int next_id_ = 0;
+  MeshingStats stats_;
+  Clock::time_point last_report_ = Clock::now();
+};
+
+}  // namespace skinmesh::detail

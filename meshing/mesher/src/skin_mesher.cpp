@@ -1,0 +1,554 @@
+// Restricted Delaunay refinement of the skin (see skin_mesher.hpp): facet
+// evaluation, seeding, refinement, the global checks and the extraction of
+// the mesh. The clean-up by edge contraction is in edge_contraction.cpp.
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/core/error.hpp"
+
+#include "refiner.hpp"
+#include "skin_seeds.hpp"
+
+namespace skinmesh::detail {
+
+FacetEval Refiner::evaluate(const Facet& facet) const {
+  Cell_handle c = facet.first;
+  int i = facet.second;
+  if (dt_.is_infinite(c)) {
+    Cell_handle m = c->neighbor(i);
+    i = m->index(c);
+    c = m;
+  }
+  FacetEval e;
+  e.stamp_c = c->info().value;
+  e.stamp_n = c->neighbor(i)->info().value;
+  for (int k = 0; k < 3; ++k) e.v[static_cast<size_t>(k)] = c->vertex((i + 1 + k) & 3);
+  // Canonical form, whichever cell the facet was reached from: vertices in
+  // insertion order and the Voronoi edge walked along +normal. Near-degenerate
+  // configurations then get the same answer in every pass and every process.
+  std::sort(e.v.begin(), e.v.end(), [](Vertex_handle x, Vertex_handle y) { return x->info().id < y->info().id; });
+  const Eigen::Vector3d p0 = to_eigen(e.v[0]->point()), p1 = to_eigen(e.v[1]->point()),
+                        p2 = to_eigen(e.v[2]->point());
+  // The Voronoi edge lies on the line through the triangle's circumcentre along
+  // its normal. Computing it from the triangle, and only the parameters of its
+  // ends from the two tetrahedra, keeps it accurate when a tetrahedron is flat
+  // (nearly cocircular samples, common on sphere patches) and its circumcentre
+  // is ill-conditioned: every point found on it is then truly equidistant from
+  // the triangle's vertices.
+  const Eigen::Vector3d u = p1 - p0, w = p2 - p0;
+  const Eigen::Vector3d uxw = u.cross(w);
+  const double cross2 = uxw.squaredNorm();
+  if (!(cross2 > 0)) return e;  // collinear samples: no triangle, nothing to test
+  const Eigen::Vector3d circumcenter = p0 + (u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)) / (2.0 * cross2);
+  const Eigen::Vector3d normal = uxw / std::sqrt(cross2);
+  const double circumradius2 = (circumcenter - p0).squaredNorm();
+  const double reach = (circumcenter - box_center_).norm() + box_radius_;
+  // Parameter along `normal` of the circumcentre of the tetrahedron with apex q.
+  auto end_parameter = [&](const Eigen::Vector3d& q) {
+    const double height = normal.dot(q - circumcenter);
+    const double numerator = (q - circumcenter).squaredNorm() - circumradius2;
+    if (std::abs(numerator) >= 2.0 * reach * std::abs(height)) return std::copysign(reach, numerator * height);
+    return numerator / (2.0 * height);
+  };
+  const Eigen::Vector3d apex_c = to_eigen(c->vertex(i)->point());
+  double lambda_c = end_parameter(apex_c), lambda_n;
+  const Cell_handle n = c->neighbor(i);
+  std::optional<Eigen::Vector3d> apex_n;
+  if (dt_.is_infinite(n)) {
+    // Convex hull facet: the Voronoi edge is a ray leaving the hull.
+    lambda_n = normal.dot(apex_c - circumcenter) > 0 ? -reach : reach;
+  } else {
+    apex_n = to_eigen(n->vertex(n->index(c))->point());
+    lambda_n = end_parameter(*apex_n);
+  }
+  const Eigen::Vector3d a = circumcenter + std::min(lambda_c, lambda_n) * normal,
+                        b = circumcenter + std::max(lambda_c, lambda_n) * normal;
+  auto hits = complex_.intersect_segment(a, b, e.v[0]->info().cell);
+  // A point inside the Voronoi edge is strictly nearer to the triangle's
+  // vertices than to either apex. When a tetrahedron is flat (its apex
+  // cocircular with the triangle, which refinement on sphere patches does
+  // produce) the end of the edge is ill-conditioned, and where the apex is
+  // equidistant the crossing is a degenerate Voronoi vertex. Such crossings are
+  // dropped: inserting them would land on or next to a sample.
+  hits.erase(std::remove_if(hits.begin(), hits.end(),
+                            [&](const SegmentCrossing& h) {
+                              const double r2 = (h.point - p0).squaredNorm() * (1 + 1e-7);
+                              return (h.point - apex_c).squaredNorm() < r2 ||
+                                     (apex_n && (h.point - *apex_n).squaredNorm() < r2);
+                            }),
+             hits.end());
+  e.crossings = static_cast<int>(hits.size());
+  if (hits.empty()) return e;
+  size_t best = 0;
+  double best_r2 = -1;
+  for (size_t k = 0; k < hits.size(); ++k) {
+    const double r2 = (hits[k].point - p0).squaredNorm();
+    if (r2 > best_r2) {
+      best_r2 = r2;
+      best = k;
+    }
+  }
+  e.center = hits[best].point;
+  e.cell = hits[best].cell;
+  e.radius = std::sqrt(best_r2);
+  e.outward = hits[best].entering ? (a - b) : (b - a);
+  RestrictedTriangle triangle;
+  triangle.corners = {p0, p1, p2};
+  triangle.ball_center = e.center;
+  triangle.ball_cell = e.cell;
+  triangle.crossings = e.crossings;
+  e.defect = triangle_defect(complex_, triangle, options_);
+  return e;
+}
+
+void Refiner::report(const char* stage, Report when, long pending) {
+  if (!options_.progress) return;
+  if (when == Report::throttled && seconds_since(last_report_) < 0.25) return;
+  last_report_ = Clock::now();
+  MeshingProgress p;
+  p.stage = stage;
+  p.vertices = static_cast<long>(dt_.number_of_vertices());
+  p.pending = pending;
+  options_.progress(p);
+}
+
+void Refiner::check_budget() const {
+  // A closed surface mesh has about twice as many triangles as vertices.
+  const long estimate = 2 * static_cast<long>(dt_.number_of_vertices());
+  if (estimate > options_.max_triangles)
+    throw RefinementStopped{MeshingStatus::over_budget,
+                            "refinement passed the budget of " + std::to_string(options_.max_triangles) +
+                                " triangles; raise the budget or ask for larger triangles (a larger epsilon, "
+                                "edge length or tolerance)"};
+}
+
+Vertex_handle Refiner::insert(const Eigen::Vector3d& point, int cell, Cell_handle hint) {
+  // A crossing is a root of the cell's quadric, so it is on the skin to
+  // rounding; where that root is ill-conditioned (a nearly tangent Voronoi
+  // edge, a tiny sphere far from the origin) one projection step restores it.
+  Eigen::Vector3d p = point;
+  const SkinEval check = complex_.evaluate(p, cell);
+  if (std::abs(check.value) > 1e-13 * check.gradient.norm()) {
+    const Projection polished = complex_.project(p, check.cell, 1e-14);
+    if (polished.converged) {
+      p = polished.point;
+      cell = polished.cell;
+    }
+  }
+  const Vertex_handle v = dt_.insert(K::Point_3(p[0], p[1], p[2]), hint);
+  if (v->info().id < 0) {
+    v->info().cell = cell;
+    v->info().id = next_id_++;
+    star_.clear();
+    dt_.incident_cells(v, std::back_inserter(star_));
+    for (const Cell_handle& c : star_) c->info().value = ++stamp_;
+    recent_.push_back(v);
+  }
+  return v;
+}
+
+void Refiner::insert_seeds() {
+  // Seeds closer than a quarter of the target edge length to a kept one are
+  // dropped: a pair of nearly coincident critical points (common where a
+  // critical point sits near a cell boundary) would otherwise force refinement
+  // down to their distance. A component still keeps its seeds unless all of
+  // them lie that close to another component, which the curvature sizing rules
+  // out (a component that small has curvature radius, hence target length, of
+  // its own size or less).
+  const auto seeds = detail::critical_point_seeds(complex_);
+  Cell_handle hint;
+  for (const auto& s : seeds) {
+    const K::Point_3 p(s.point[0], s.point[1], s.point[2]);
+    if (dt_.number_of_vertices() > 0) {
+      const Vertex_handle nearest = dt_.nearest_vertex(p, hint);
+      const Eigen::Vector3d q = to_eigen(nearest->point());
+      const double spacing = 0.25 * std::min(target_edge_length(complex_, s.point, s.cell, options_),
+                                             target_edge_length(complex_, q, nearest->info().cell, options_));
+      if ((q - s.point).norm() < spacing) continue;
+    }
+    const Vertex_handle v = insert(s.point, s.cell, hint);
+    hint = v->cell();
+    ++stats_.seeds;
+  }
+}
+
+void Refiner::push_if_bad(const FacetEval& e) {
+  if (e.crossings > 0 && e.defect != TriangleDefect::none) pending_.push_back(e);
+}
+
+void Refiner::push_repair(FacetEval e) {
+  if (e.crossings == 0) return;
+  e.force = true;
+  pending_.push_back(e);
+}
+
+// Every facet of the star of a new vertex is new or has a new Voronoi edge;
+// each is listed once (the cells of the star are the ones the insertion made).
+std::vector<Facet> Refiner::star_facets(Vertex_handle v) const {
+  std::vector<Facet> out;
+  for (const Cell_handle& c : star_) {
+    const bool infinite = dt_.is_infinite(c);
+    const int iv = c->index(v);
+    for (int j = 0; j < 4; ++j) {
+      if (infinite && j != c->index(dt_.infinite_vertex())) continue;  // only its finite facet
+      if (j != iv && &*c->neighbor(j) < &*c) continue;  // a facet through v lies in two cells of the star
+      out.emplace_back(c, j);
+    }
+  }
+  return out;
+}
+
+std::vector<FacetEval> Refiner::evaluate_all(const std::vector<Facet>& facets) const {
+  std::vector<FacetEval> evals(facets.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, facets.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) evals[k] = evaluate(facets[k]);
+  });
+  return evals;
+}
+
+// Refinement: insert the surface ball centre of the pending bad facet with the
+// largest ball, evaluate the facets of the new vertex's star, repeat. An entry
+// whose cells changed since its evaluation is evaluated again first.
+void Refiner::refine() {
+  auto smaller = [](const FacetEval& a, const FacetEval& b) { return a.radius < b.radius; };
+  std::priority_queue<FacetEval, std::vector<FacetEval>, decltype(smaller)> queue(smaller, std::move(pending_));
+  pending_.clear();
+  while (!queue.empty()) {
+    FacetEval e = queue.top();
+    queue.pop();
+    Cell_handle c;
+    int i0, i1, i2;
+    if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) continue;
+    const Cell_handle n = c->neighbor(6 - i0 - i1 - i2);
+    const unsigned sc = c->info().value, sn = n->info().value;
+    if (!((sc == e.stamp_c && sn == e.stamp_n) || (sc == e.stamp_n && sn == e.stamp_c))) {
+      const bool force = e.force;
+      e = evaluate(Facet(c, 6 - i0 - i1 - i2));  // its Voronoi edge changed: look again
+      if (e.crossings > 0 && (e.defect != TriangleDefect::none || force)) {
+        e.force = force;
+        queue.push(e);
+      }
+      continue;
+    }
+    if (e.radius < 1e-9) continue;  // cannot happen for a proper triangle; never insert a duplicate
+    // The surface Delaunay ball is empty in exact arithmetic. Near a Voronoi
+    // vertex on the skin two Voronoi edges cross it at almost the same point;
+    // after one is inserted the other must not be (a near-duplicate vertex
+    // would send refinement chasing it).
+    const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
+    if ((to_eigen(nearest->point()) - e.center).norm() < 0.5 * e.radius) continue;
+    switch (e.defect) {
+      case TriangleDefect::topology: ++stats_.inserted_topology; break;
+      case TriangleDefect::size: ++stats_.inserted_size; break;
+      case TriangleDefect::distance: ++stats_.inserted_distance; break;
+      case TriangleDefect::shape: ++stats_.inserted_shape; break;
+      case TriangleDefect::none: ++stats_.inserted_topology; break;  // forced: a vertex star repair
+    }
+    const int before = next_id_;
+    const Vertex_handle v = insert(e.center, e.cell, c);
+    if (next_id_ == before) continue;  // the point is a sample already
+    for (const Facet& f : star_facets(v)) {
+      const FacetEval te = evaluate(f);
+      if (te.crossings > 0 && te.defect != TriangleDefect::none) queue.push(te);
+    }
+    if ((next_id_ & 1023) == 0) {
+      check_budget();
+      report("refining", Report::throttled, static_cast<long>(queue.size()));
+    }
+  }
+}
+
+bool is_single_cycle(const std::vector<std::pair<int, int>>& edges) {
+  if (edges.empty()) return false;
+  // One cycle: every link vertex has degree two and a walk visits every edge.
+  std::unordered_map<int, std::array<int, 2>> adjacent;
+  for (const auto& [a, b] : edges) {
+    for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}}) {
+      auto [it, fresh] = adjacent.try_emplace(x, std::array<int, 2>{{y, -1}});
+      if (!fresh) {
+        if (it->second[1] >= 0) return false;
+        it->second[1] = y;
+      }
+    }
+  }
+  for (const auto& [x, ys] : adjacent)
+    if (ys[1] < 0) return false;
+  int prev = edges[0].first, cur = edges[0].second;
+  size_t steps = 1;
+  while (cur != edges[0].first && steps <= edges.size()) {
+    const auto& ys = adjacent[cur];
+    const int next = ys[0] == prev ? ys[1] : ys[0];
+    prev = cur;
+    cur = next;
+    ++steps;
+  }
+  return steps == edges.size();
+}
+
+// Classifies every Delaunay facet (in parallel), queues the bad ones and the
+// repairs of vertex stars that are not disks. Returns true when nothing is left
+// to do; then `restricted` holds the restricted facets.
+bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
+  ++stats_.passes;
+  recent_.clear();  // this pass looks at everything
+  // A facet whose two cells are older than the previous pass has the same
+  // Voronoi edge, hence the same evaluation: take it from that pass (restricted
+  // facets are kept; any other unchanged facet was not restricted). Only the
+  // facets of new cells are evaluated again.
+  std::vector<Facet> facets;
+  restricted->clear();
+  for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) {
+    if (have_pass_cache_) {
+      const Cell_handle c = f->first, n = c->neighbor(f->second);
+      if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
+        const auto it = pass_cache_.find(facet_key(*f));
+        if (it != pass_cache_.end()) restricted->push_back(it->second);
+        continue;
+      }
+    }
+    facets.push_back(*f);
+  }
+  const std::vector<FacetEval> evals = evaluate_all(facets);
+  for (const FacetEval& e : evals)
+    if (e.crossings > 0) restricted->push_back(e);
+  pass_cache_.clear();
+  pass_cache_.reserve(restricted->size());
+  for (const FacetEval& e : *restricted)
+    pass_cache_.emplace(facet_key(e), e);
+  last_pass_stamp_ = stamp_;
+  have_pass_cache_ = true;
+  bool clean = true;
+  for (const FacetEval& e : *restricted) {
+    if (e.defect != TriangleDefect::none) {
+      push_if_bad(e);
+      clean = false;
+    }
+  }
+  if (!clean) return false;
+
+  std::vector<Vertex_handle> all;
+  all.reserve(dt_.number_of_vertices());
+  for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end(); ++v) all.push_back(v);
+  return repair_stars(*restricted, all);
+}
+
+// Checks that each of `vertices` has restricted triangles forming one disk
+// (its link is a single cycle, which also makes every edge shared by exactly
+// two triangles) and queues or makes the repairs. `restricted` must hold every
+// restricted facet around each of them. Returns true when all are disks.
+bool Refiner::repair_stars(const std::vector<FacetEval>& restricted, const std::vector<Vertex_handle>& vertices) {
+  bool clean = true;
+  Links link;
+  std::unordered_map<int, int> best_facet;  // per listed vertex: its restricted facet with the largest ball
+  link.reserve(vertices.size());
+  for (const Vertex_handle& v : vertices) link[v->info().id];
+  for (int f = 0; f < static_cast<int>(restricted.size()); ++f) {
+    const FacetEval& e = restricted[static_cast<size_t>(f)];
+    const FacetKey ids{{e.v[0]->info().id, e.v[1]->info().id, e.v[2]->info().id}};
+    add_to_links(ids, LinkScope::listed_vertices, link);
+    for (int me : ids) {
+      if (!link.count(me)) continue;
+      auto [best, fresh] = best_facet.try_emplace(me, f);
+      if (!fresh && e.radius > restricted[static_cast<size_t>(best->second)].radius) best->second = f;
+    }
+  }
+  std::vector<Vertex_handle> isolated;
+  for (const Vertex_handle& v : vertices) {
+    const int id = v->info().id;
+    const auto& edges = link[id];
+    if (edges.empty()) {
+      isolated.push_back(v);
+      continue;
+    }
+    if (!is_single_cycle(edges)) {
+      push_repair(restricted[static_cast<size_t>(best_facet[id])]);
+      clean = false;
+    }
+  }
+  // A sample with no restricted triangle: the skin around it escapes every
+  // Voronoi edge of its cell. Add a skin point inside that Voronoi cell (the
+  // projection of one of its Voronoi vertices, the farthest from the sample);
+  // the triangulation then sees that piece. A projection that lands in another
+  // sample's cell is used only when none stays in this one: it does not
+  // split this cell, so repeating it can go on for ever (a 0.005 A void of
+  // 1ubi does that when its Voronoi vertices project onto the outer skin).
+  for (const Vertex_handle& v : isolated) {
+    std::vector<Cell_handle> cells;
+    dt_.incident_cells(v, std::back_inserter(cells));
+    const Eigen::Vector3d pv = to_eigen(v->point());
+    std::optional<Projection> best;
+    bool best_in_cell = false;
+    for (const Cell_handle& c : cells) {
+      if (dt_.is_infinite(c)) continue;
+      const Projection p = complex_.project(to_eigen(dt_.dual(c)), v->info().cell);
+      if (!p.converged || (p.point - pv).norm() < 1e-6) continue;
+      const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(p.point[0], p.point[1], p.point[2]), c);
+      if ((to_eigen(nearest->point()) - p.point).norm() < 1e-6) continue;
+      const bool in_cell = nearest == v;
+      if (!best || (in_cell && !best_in_cell) ||
+          (in_cell == best_in_cell && (p.point - pv).norm() > (best->point - pv).norm())) {
+        best = p;
+        best_in_cell = in_cell;
+      }
+    }
+    if (!best)
+      throw RefinementStopped{MeshingStatus::unrepairable,
+                              "a sample of the skin has no triangle and no repair point was found"};
+    ++stats_.inserted_topology;
+    insert(best->point, best->cell, v->cell());  // the next pass looks at it
+    clean = false;
+  }
+  return clean;
+}
+
+SurfaceMesh Refiner::extract(const std::vector<FacetEval>& restricted) const {
+  SurfaceMesh mesh;
+  std::vector<int> index(static_cast<size_t>(next_id_), -1);
+  for (const FacetEval& e : restricted) {
+    std::array<int, 3> t;
+    for (int k = 0; k < 3; ++k) {
+      const Vertex_handle v = e.v[static_cast<size_t>(k)];
+      int& slot = index[static_cast<size_t>(v->info().id)];
+      if (slot < 0) {
+        slot = static_cast<int>(mesh.vertices.size());
+        const Eigen::Vector3d p = to_eigen(v->point());
+        const SkinEval se = complex_.evaluate(p, v->info().cell);
+        mesh.vertices.push_back(p);
+        mesh.normals.push_back(se.gradient.normalized());
+        mesh.cells.push_back(se.cell);
+      }
+      t[static_cast<size_t>(k)] = slot;
+    }
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
+    const Eigen::Vector3d normal =
+        (mesh.vertices[static_cast<size_t>(t[1])] - a).cross(mesh.vertices[static_cast<size_t>(t[2])] - a);
+    if (normal.dot(e.outward) < 0) std::swap(t[1], t[2]);
+    mesh.triangles.push_back(t);
+  }
+  return mesh;
+}
+
+// After refinement, the stars around the vertices it inserted are checked
+// here, not by another global pass: repairs come in short chains (a repair
+// point upsets a neighbour), and each global pass walks every facet (on 3mht,
+// 2.4 million). The facets around the region are evaluated again unless both
+// their cells are older than the last global pass.
+void Refiner::local_passes() {
+  // After a large refinement the region is most of the mesh, and one global
+  // pass (which visits each facet once) is cheaper.
+  const size_t most = std::max<size_t>(64, dt_.number_of_vertices() / 100);
+  for (int round = 0; round < 50 && !recent_.empty() && recent_.size() <= most; ++round) {
+    std::vector<Vertex_handle> region;
+    for (const Vertex_handle& v : recent_) {
+      region.push_back(v);
+      dt_.finite_adjacent_vertices(v, std::back_inserter(region));
+    }
+    recent_.clear();
+    std::sort(region.begin(), region.end());
+    region.erase(std::unique(region.begin(), region.end()), region.end());
+    std::vector<FacetEval> restricted;
+    bool defects = false;
+    for_each_facet_around(region, [&](const Facet& f, const FacetKey& key) {
+      const Cell_handle c = f.first, n = c->neighbor(f.second);
+      if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
+        const auto it = pass_cache_.find(key);
+        if (it != pass_cache_.end()) restricted.push_back(it->second);
+        return true;
+      }
+      const FacetEval e = evaluate(f);
+      if (e.crossings == 0) return true;
+      restricted.push_back(e);
+      if (e.defect != TriangleDefect::none) {
+        push_if_bad(e);
+        defects = true;
+      }
+      return true;
+    });
+    if (defects || !repair_stars(restricted, region)) refine();
+  }
+}
+
+// Global passes and refinement until a pass finds nothing to do.
+void Refiner::refine_until_clean(std::vector<FacetEval>* restricted) {
+  for (;;) {
+    report("checking", Report::now);
+    const auto before = dt_.number_of_vertices();
+    if (global_pass(restricted)) return;
+    refine();
+    local_passes();
+    check_budget();
+    // Every bad triangle found by a pass gets a new vertex unless its surface
+    // ball centre coincides with a sample, which only rounding can cause
+    // (flat Delaunay tetrahedra of cocircular samples). Say so, never spin.
+    if (dt_.number_of_vertices() == before)
+      throw RefinementStopped{MeshingStatus::stalled,
+                              "refinement stalled: the bad triangles left have surface Delaunay ball centres at "
+                              "existing samples (numerically degenerate Delaunay tetrahedra)"};
+  }
+}
+
+SkinMeshResult Refiner::run() {
+  const auto start = Clock::now();
+  report("seeding", Report::now);
+  insert_seeds();
+  stats_.seconds_seeding = seconds_since(start);
+  const auto refine_start = Clock::now();
+  std::vector<FacetEval> restricted;
+  refine_until_clean(&restricted);
+  stats_.seconds_refining = seconds_since(refine_start);
+  // Clean-up: contract short edges (one round: a contraction blocks its
+  // neighbourhood for the round, and further rounds found few more), then
+  // check globally and refine again if that finds anything (it should not:
+  // each contraction is checked locally).
+  if (options_.contract_below > 0) {
+    const auto contract_start = Clock::now();
+    report("contracting", Report::now);
+    if (contract_short_edges(restricted) > 0) refine_until_clean(&restricted);
+    stats_.seconds_contracting = seconds_since(contract_start);
+  }
+  SkinMeshResult result;
+  result.mesh = extract(restricted);
+  stats_.seconds_total = seconds_since(start);
+  result.stats = stats_;
+  return result;
+}
+
+}  // namespace skinmesh::detail
+
+namespace skinmesh {
+
+const char* meshing_status_name(MeshingStatus status) {
+  switch (status) {
+    case MeshingStatus::ok: return "ok";
+    case MeshingStatus::over_budget: return "over_budget";
+    case MeshingStatus::stalled: return "stalled";
+    case MeshingStatus::unrepairable: return "unrepairable";
+  }
+  return "unknown";
+}
+
+SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& options) {
+  if (!(options.min_angle > 0 && options.min_angle <= 30.0))
+    contract_error("the angle bound must be in (0, 30] degrees (Delaunay refinement "
+                                "terminates for bounds up to about 30 degrees)");
+  if (!(options.tolerance > 0)) contract_error("the distance tolerance must be positive");
+  if (!(options.edge_length >= 0)) contract_error("the edge length must be positive");
+  if (!(options.sizing.epsilon > 0) || !(options.sizing.min_size > 0) ||
+      !(options.sizing.max_size >= options.sizing.min_size))
+    contract_error("sizing: epsilon and min_size must be positive, max_size >= min_size");
+  if (options.max_triangles <= 0) contract_error("the triangle budget must be positive");
+  if (!(options.contract_below >= 0 && options.contract_below < 1))
+    contract_error("the contraction threshold must be in [0, 1) times the target edge length");
+  std::optional<tbb::global_control> threads;
+  if (options.threads > 0)
+    threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
+  detail::Refiner refiner(complex, options);
+  try {
+    return refiner.run();
+  } catch (const detail::RefinementStopped& stop) {
+    SkinMeshResult result;
+    result.status = stop.status;
+    result.message = stop.message;
+    return result;
+  }
+}
+
+}  // namespace skinmesh

@@ -1,0 +1,67 @@
+// Grading a triangle mesh, ours or another tool's: element quality, size,
+// topology (components, Euler characteristic, genus), defects (boundary and
+// non-manifold edges and vertices, inconsistent orientation, zero-area
+// triangles) and self-intersections.
+#pragma once
+
+#include "skinmesh/core/surface_mesh.hpp"
+
+#include <map>
+#include <vector>
+
+namespace skinmesh {
+
+struct Histogram {
+  double lo = 0, hi = 0;       // range of the bins
+  std::vector<long> counts;    // equal-width bins
+};
+
+struct MeshQuality {
+  long vertices = 0, triangles = 0, edges = 0;
+  double min_angle = 0, max_angle = 0;       // degrees, over all triangles
+  double mean_min_angle = 0;                 // degrees, mean of each triangle's smallest angle
+  double share_below_20 = 0, share_below_10 = 0;  // share of triangles whose smallest angle is below
+  double max_radius_edge = 0;                // circumradius / shortest edge (1/sqrt(3) when equilateral)
+  double max_aspect = 0;                     // circumradius / (2 inradius) (1 when equilateral)
+  double min_edge = 0, mean_edge = 0, max_edge = 0;  // Angstrom
+  std::map<int, long> valence;               // triangles around a vertex -> vertices
+  double area = 0;                           // Angstrom^2
+  double volume = 0;                         // Angstrom^3, signed (positive for outward triangles)
+  long components = 0;
+  long cavities = 0;                         // components enclosing negative volume (inner surfaces of voids)
+  long euler = 0;                            // V - E + F (vertices used by triangles)
+  long genus = -1;                           // total genus; -1 unless closed, manifold, oriented
+  long boundary_edges = 0, nonmanifold_edges = 0, nonmanifold_vertices = 0;
+  long inconsistent_edges = 0;               // edges whose two triangles run them the same way
+  long degenerate_triangles = 0;             // zero area
+  long unused_vertices = 0;
+  bool closed = false, manifold = false, oriented = false;
+  bool self_intersections_checked = false;   // exact check needs a manifold mesh
+  long self_intersecting_pairs = 0;
+  Histogram min_angle_histogram;             // 0-60 degrees, 12 bins
+};
+
+enum class SelfIntersectionCheck { exact, skip };  // exact: CGAL, O(n log n) with box intersection
+
+struct GradeOptions {
+  SelfIntersectionCheck self_intersections = SelfIntersectionCheck::exact;
+};
+
+MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options = {});
+
+// Exact self-intersection check of a manifold mesh (CGAL Polygon_mesh_processing):
+// the number of intersecting triangle pairs, or -1 when the mesh cannot be
+// built as a manifold surface.
+long count_self_intersections(const SurfaceMesh& mesh);
+
+// The connected components of a mesh's triangles (through shared vertices)
+// and the signed volume each encloses: with outward normals, a closed
+// component enclosing negative volume is the inward-facing surface of a cavity.
+struct SurfaceComponents {
+  std::vector<int> of_triangle;          // component of each triangle, 0-based
+  std::vector<double> enclosed_volume;   // Angstrom^3 per component, signed
+  bool is_cavity(int component) const { return enclosed_volume[static_cast<size_t>(component)] < 0; }
+};
+SurfaceComponents surface_components(const SurfaceMesh& mesh);
+
+}  // namespace skinmesh

@@ -1,0 +1,183 @@
+// Grading a triangle mesh (see mesh_quality.hpp).
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include "union_find.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+namespace skinmesh {
+namespace {
+
+constexpr double kDegrees = 180.0 / M_PI;
+
+using detail::UnionFind;
+
+uint64_t edge_key(int a, int b) {
+  const auto lo = static_cast<uint64_t>(std::min(a, b)), hi = static_cast<uint64_t>(std::max(a, b));
+  return (lo << 32) | hi;
+}
+
+// Per triangle: angles, radius-edge ratio, aspect, area, volume.
+void grade_triangles(const SurfaceMesh& mesh, MeshQuality& q) {
+  const auto& V = mesh.vertices;
+  q.triangles = static_cast<long>(mesh.triangles.size());
+  q.min_angle = 180;
+  q.min_angle_histogram = {0, 60, std::vector<long>(12, 0)};
+  double sum_min_angle = 0;
+  long below20 = 0, below10 = 0;
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d& a = V[t[0]];
+    const Eigen::Vector3d& b = V[t[1]];
+    const Eigen::Vector3d& c = V[t[2]];
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const double area = 0.5 * cross.norm();
+    q.area += area;
+    q.volume += a.dot(b.cross(c)) / 6.0;
+    const double la = (b - c).norm(), lb = (c - a).norm(), lc = (a - b).norm();
+    const double shortest = std::min({la, lb, lc});
+    auto angle = [](const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+      return std::atan2((u - p).cross(v - p).norm(), (u - p).dot(v - p)) * kDegrees;
+    };
+    const double A = angle(a, b, c), B = angle(b, c, a), C = angle(c, a, b);
+    const double smallest = std::min({A, B, C});
+    q.min_angle = std::min(q.min_angle, smallest);
+    q.max_angle = std::max(q.max_angle, std::max({A, B, C}));
+    sum_min_angle += smallest;
+    below20 += smallest < 20;
+    below10 += smallest < 10;
+    ++q.min_angle_histogram.counts[std::min<size_t>(11, static_cast<size_t>(smallest / 5.0))];
+    if (area <= 0) {
+      ++q.degenerate_triangles;
+      q.max_radius_edge = q.max_aspect = INFINITY;
+    } else {
+      const double circumradius = la * lb * lc / (4 * area);
+      const double inradius = 2 * area / (la + lb + lc);
+      q.max_radius_edge = std::max(q.max_radius_edge, circumradius / shortest);
+      q.max_aspect = std::max(q.max_aspect, circumradius / (2 * inradius));
+    }
+  }
+  if (q.triangles) {
+    q.mean_min_angle = sum_min_angle / q.triangles;
+    q.share_below_20 = static_cast<double>(below20) / q.triangles;
+    q.share_below_10 = static_cast<double>(below10) / q.triangles;
+  }
+}
+
+// Edges: how many triangles use each, and in which directions.
+void grade_edges(const SurfaceMesh& mesh, MeshQuality& q) {
+  struct EdgeUse {
+    int count = 0;
+    int forward = 0;  // uses as (min -> max)
+  };
+  const auto& V = mesh.vertices;
+  q.min_edge = INFINITY;
+  std::unordered_map<uint64_t, EdgeUse> edges;
+  edges.reserve(mesh.triangles.size() * 2);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      EdgeUse& e = edges[edge_key(a, b)];
+      ++e.count;
+      e.forward += a < b;
+    }
+  q.edges = static_cast<long>(edges.size());
+  double sum_edge = 0;
+  for (const auto& [key, use] : edges) {
+    const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
+    const double length = (V[a] - V[b]).norm();
+    q.min_edge = std::min(q.min_edge, length);
+    q.max_edge = std::max(q.max_edge, length);
+    sum_edge += length;
+    if (use.count == 1) ++q.boundary_edges;
+    if (use.count > 2) ++q.nonmanifold_edges;
+    if (use.count == 2 && use.forward != 1) ++q.inconsistent_edges;
+  }
+  if (q.edges) q.mean_edge = sum_edge / q.edges;
+  if (!q.edges) q.min_edge = 0;
+}
+
+// Vertices: valence, and whether the triangles around each form one fan.
+void grade_vertices(const SurfaceMesh& mesh, MeshQuality& q) {
+  const auto& T = mesh.triangles;
+  std::vector<std::vector<int>> around(mesh.vertices.size());
+  for (size_t f = 0; f < T.size(); ++f)
+    for (int k = 0; k < 3; ++k) around[T[f][k]].push_back(static_cast<int>(f));
+  long used = 0;
+  for (size_t v = 0; v < around.size(); ++v) {
+    const auto& fan = around[v];
+    if (fan.empty()) {
+      ++q.unused_vertices;
+      continue;
+    }
+    ++used;
+    ++q.valence[static_cast<int>(fan.size())];
+    // Fans: triangles around v joined when they share an edge through v.
+    UnionFind uf(fan.size());
+    std::unordered_map<int, int> first_with_other;  // other endpoint -> local triangle
+    for (size_t i = 0; i < fan.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const int w = T[fan[i]][k];
+        if (w == static_cast<int>(v)) continue;
+        auto [it, inserted] = first_with_other.emplace(w, static_cast<int>(i));
+        if (!inserted) uf.unite(static_cast<int>(i), it->second);
+      }
+    long fans = 0;
+    for (size_t i = 0; i < fan.size(); ++i) fans += uf.find(static_cast<int>(i)) == static_cast<int>(i);
+    if (fans > 1) ++q.nonmanifold_vertices;
+  }
+  q.vertices = used;
+}
+
+}  // namespace
+
+SurfaceComponents surface_components(const SurfaceMesh& mesh) {
+  UnionFind uf(mesh.vertices.size());
+  for (const auto& t : mesh.triangles) uf.unite(t[0], t[1]), uf.unite(t[1], t[2]);
+  SurfaceComponents out;
+  std::vector<int> label(mesh.vertices.size(), -1);
+  for (const auto& t : mesh.triangles) {
+    int& l = label[static_cast<size_t>(uf.find(t[0]))];
+    if (l < 0) {
+      l = static_cast<int>(out.enclosed_volume.size());
+      out.enclosed_volume.push_back(0.0);
+    }
+    out.of_triangle.push_back(l);
+    const auto& V = mesh.vertices;
+    out.enclosed_volume[static_cast<size_t>(l)] +=
+        V[static_cast<size_t>(t[0])].dot(V[static_cast<size_t>(t[1])].cross(V[static_cast<size_t>(t[2])])) / 6.0;
+  }
+  return out;
+}
+
+MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
+  MeshQuality q;
+  grade_triangles(mesh, q);
+  grade_edges(mesh, q);
+  grade_vertices(mesh, q);
+  const SurfaceComponents components = surface_components(mesh);
+  q.components = static_cast<long>(components.enclosed_volume.size());
+  q.euler = q.vertices - q.edges + q.triangles;
+  q.closed = q.boundary_edges == 0;
+  q.manifold = q.nonmanifold_edges == 0 && q.nonmanifold_vertices == 0;
+  q.oriented = q.inconsistent_edges == 0;
+  if (q.closed && q.manifold && q.oriented) {
+    q.genus = (2 * q.components - q.euler) / 2;
+    // A closed component that encloses negative volume faces inward: with
+    // outward normals everywhere else, it is the surface of a cavity.
+    for (int c = 0; c < static_cast<int>(q.components); ++c) q.cavities += components.is_cavity(c);
+  }
+  if (options.self_intersections == SelfIntersectionCheck::exact && q.manifold && q.oriented &&
+      q.degenerate_triangles == 0) {
+    const long pairs = count_self_intersections(mesh);
+    q.self_intersections_checked = pairs >= 0;
+    q.self_intersecting_pairs = std::max(0L, pairs);
+  }
+  return q;
+}
+
+}  // namespace skinmesh

@@ -1,0 +1,54 @@
+// Tetrahedral meshes bounded by a skin mesh, made by the TetGen program
+// (Debian's `tetgen`): the molecule's interior, the solvent between the skin
+// and a box around it, or both, with region and boundary markers
+// (core/tet_mesh.hpp). The skin's triangles stay as they are (no Steiner
+// points on the surface), so the tet mesh's boundary is the surface mesh
+// itself; the few tetrahedra TetGen then leaves outside the quality bounds
+// are mended by improve_tet_mesh (tet_improvement.hpp).
+#pragma once
+
+#include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/core/tet_mesh.hpp"
+#include "skinmesh/volume/tet_improvement.hpp"
+
+#include <string>
+
+namespace skinmesh {
+
+enum class VolumeDomain { interior, exterior, both };
+enum class Cavities { keep, fill };  // keep: mesh enclosed voids as region kRegionCavity; fill: leave them empty
+
+struct VolumeOptions {
+  VolumeDomain domain = VolumeDomain::interior;
+  double box_margin = 10.0;        // Angstrom between the skin's bounding box and the outer box
+  TetBounds bounds;                // radius-edge (TetGen -q) and dihedral (degrees) bounds
+  double max_volume = 0.0;         // Angstrom^3: largest tetrahedron, 0 for no bound (TetGen -a)
+  Cavities cavities = Cavities::keep;
+  std::string tetgen = "tetgen";   // the program
+};
+
+enum class VolumeStatus {
+  ok,
+  surface_not_closed,  // the surface is not a closed, consistently oriented manifold: it bounds no volume
+  tetgen_failed,       // TetGen could not be run, exited with an error, or wrote unreadable output
+};
+const char* volume_status_name(VolumeStatus status);
+
+struct VolumeMeshResult {
+  VolumeStatus status = VolumeStatus::ok;
+  std::string message;             // what went wrong, when status != ok
+  TetMesh mesh;                    // empty unless status == ok
+  TetImprovement improvement;      // what improve_tet_mesh did to TetGen's output
+};
+
+// The surface must be closed, manifold and outward oriented (as skinmesh
+// writes it); components with negative enclosed volume are cavities. Throws
+// ContractError for options out of range.
+VolumeMeshResult tetrahedralize(const SurfaceMesh& surface, const VolumeOptions& options = {});
+
+// A second opinion on self-intersections, independent of CGAL: TetGen's -d
+// check of the surface. The number of intersecting triangle pairs, or -1 when
+// TetGen could not be run.
+long tetgen_self_intersections(const SurfaceMesh& surface, const std::string& tetgen = "tetgen");
+
+}  // namespace skinmesh

@@ -1,0 +1,265 @@
+// The skinmesh command: exit codes and messages a user sees.
+#include "cgal_reference.hpp"
+#include "test_support.hpp"
+
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/mesh_io/mesh_write.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <cstdio>
+#include <sys/wait.h>
+
+namespace {
+
+struct Run {
+  int code;
+  std::string output;  // stdout and stderr together
+};
+
+Run run(const std::string& args) {
+  const std::string command = std::string(SKINMESH_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string output;
+  std::array<char, 4096> buffer{};
+  size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+}  // namespace
+
+TEST_CASE("skinmesh info reports atoms, radii and the complex", "[cli]") {
+  const Run r = run("info " + skinmesh::test::data_file("pept.pdb"));
+  INFO(r.output);
+  CHECK(r.code == 0);
+  CHECK(r.output.find("atoms read:     107") != std::string::npos);
+  CHECK(r.output.find("tetrahedra") != std::string::npos);
+  CHECK(r.output.find("hidden balls:   0") != std::string::npos);
+}
+
+TEST_CASE("skinmesh info --json is machine-readable", "[cli]") {
+  const Run r = run("info --json " + skinmesh::test::data_file("2k39_3models.pdb") + " --all-models");
+  INFO(r.output);
+  CHECK(r.code == 0);
+  CHECK(r.output.front() == '[');
+  CHECK(r.output.find("\"models_in_file\": 3") != std::string::npos);
+  CHECK(r.output.find("\"tetrahedron\":") != std::string::npos);
+}
+
+TEST_CASE("skinmesh info on bad input: message names the file, non-zero exit", "[cli][bad]") {
+  const Run missing = run("info /nonexistent/file.pdb");
+  CHECK(missing.code == 2);
+  CHECK(missing.output.find("/nonexistent/file.pdb") != std::string::npos);
+  skinmesh::test::TempFile nan("nan.xyzr", "0 0 0 1.5\n1 nan 0 1.5\n");
+  const Run bad = run("info " + nan.path());
+  CHECK(bad.code == 2);
+  CHECK(bad.output.find(nan.path() + ":2:") != std::string::npos);
+  const Run usage = run("info");
+  CHECK(usage.code != 0);
+}
+
+TEST_CASE("skinmesh info runs on every PDB entry in data", "[cli]") {
+  for (const char* name : {"pept.pdb", "3al1.pdb", "1ubi.pdb", "1ejg.pdb", "1hpv.pdb", "3mht.pdb",
+                           "2k39_3models.pdb"}) {
+    const Run r = run("--quiet info " + skinmesh::test::data_file(name));
+    INFO(name << "\n" << r.output);
+    CHECK(r.code == 0);
+    CHECK(r.output.find("mixed cells:") != std::string::npos);
+  }
+}
+
+TEST_CASE("skinmesh quality grades a mesh file, writes an SVG, measures on-surface error", "[cli][quality]") {
+  // A regular tetrahedron with circumradius 1.7 about the origin, and one atom of
+  // radius 1.7 there: with w = r^2/s the atom's skin is that circumsphere.
+  const double h = 1.7 / std::sqrt(3.0);
+  char off[512];
+  std::snprintf(off, sizeof off,
+                "OFF\n4 4 0\n%.17g %.17g %.17g\n%.17g %.17g %.17g\n%.17g %.17g %.17g\n%.17g %.17g %.17g\n"
+                "3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n",
+                h, h, h, h, -h, -h, -h, h, -h, -h, -h, h);
+  skinmesh::test::TempFile mesh("tet.off", off);
+  skinmesh::test::TempFile atom("atom.xyzr", "0 0 0 1.7\n");
+  const std::string svg = mesh.path() + ".svg";
+  const Run r = run("quality " + mesh.path() + " --molecule " + atom.path() + " --svg " + svg + " --json");
+  INFO(r.output);
+  CHECK(r.code == 0);
+  CHECK(r.output.find("\"euler_characteristic\": 2") != std::string::npos);
+  CHECK(r.output.find("\"self_intersecting_pairs\": 0") != std::string::npos);
+  const size_t at = r.output.find("\"max\":", r.output.find("\"on_surface_error\""));
+  REQUIRE(at != std::string::npos);
+  CHECK(std::stod(r.output.substr(at + 6)) < 1e-12);
+  std::ifstream in(svg);
+  std::string first;
+  std::getline(in, first);
+  CHECK(first.rfind("<svg", 0) == 0);
+  std::remove(svg.c_str());
+
+  const Run missing = run("quality /nonexistent/mesh.off");
+  CHECK(missing.code == 2);
+  CHECK(missing.output.find("/nonexistent/mesh.off") != std::string::npos);
+}
+
+TEST_CASE("skinmesh quality grades CGAL's skin mesh and ours side by side", "[cli][quality]") {
+  using skinmesh::test::TempFile;
+  const std::string molecule = skinmesh::test::data_file("pept.pdb");
+  const auto balls = skinmesh::balls_from_molecule(skinmesh::read_molecule(molecule), 0.5);
+  TempFile cgal("cgal.off");
+  {
+    std::ofstream out(cgal.path());
+    skinmesh::write_mesh(out, skinmesh::test::cgal_skin_mesh(balls, 0.5), skinmesh::MeshFormat::off, nullptr);
+  }
+  TempFile ours("ours.off");
+  REQUIRE(run("--quiet mesh " + molecule + " -o " + ours.path()).code == 0);
+  auto grade = [&](const std::string& path) {
+    const Run r = run("--json quality " + path + " --molecule " + molecule);
+    INFO(r.output);
+    REQUIRE(r.code == 0);
+    return nlohmann::json::parse(r.output);
+  };
+  const nlohmann::json c = grade(cgal.path()), o = grade(ours.path());
+  INFO("CGAL: " << c.dump() << "\nskinmesh: " << o.dump());
+  // Both are closed manifolds without self-intersections, with the skin's topology.
+  for (const nlohmann::json* q : {&c, &o}) {
+    CHECK((*q)["closed"] == true);
+    CHECK((*q)["manifold"] == true);
+    CHECK((*q)["self_intersecting_pairs"] == 0);
+  }
+  CHECK(o["components"] == c["components"]);
+  CHECK(o["genus"] == c["genus"]);
+  // What the grader tells apart: only ours keeps the angle bound and has its
+  // vertices on the skin.
+  CHECK(o["min_angle_deg"].get<double>() >= 30.0 - 1e-9);
+  CHECK(c["min_angle_deg"].get<double>() < 30.0);
+  CHECK(o["on_surface_error"]["max"].get<double>() <= 1e-9);
+  CHECK(c["on_surface_error"]["max"].get<double>() > 1e-9);
+}
+
+TEST_CASE("skinmesh mesh writes a mesh, a report and MSMS files, and failures leave nothing behind", "[cli][mesh]") {
+  skinmesh::test::TempFile out("pept.ply");
+  const std::string report = out.path() + ".json";
+  const Run r = run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + out.path() + " --report " + report +
+                    " --quiet");
+  INFO(r.output);
+  CHECK(r.code == 0);
+  std::ifstream ply(out.path(), std::ios::binary);
+  std::string line;
+  std::getline(ply, line);
+  CHECK(line == "ply");
+  std::getline(ply, line);
+  CHECK(line == "format binary_little_endian 1.0");
+  std::getline(ply, line);
+  std::getline(ply, line);
+  std::getline(ply, line);
+  CHECK(line == "property double x");  // full precision by default
+  std::ifstream rep(report);
+  const std::string json((std::istreambuf_iterator<char>(rep)), std::istreambuf_iterator<char>());
+  CHECK(json.find("\"closed_oriented_manifold\": true") != std::string::npos);
+  CHECK(json.find("\"min_angle_at_least_bound\": true") != std::string::npos);
+  std::remove(report.c_str());
+
+  // The same mesh, graded by `quality` from the written file.
+  const Run q = run("quality " + out.path() + " --molecule " + skinmesh::test::data_file("pept.pdb") + " --json");
+  CHECK(q.code == 0);
+  CHECK(q.output.find("\"components\": 3") != std::string::npos);
+
+  skinmesh::test::TempFile vert("pept.vert");
+  const std::string face = vert.path().substr(0, vert.path().size() - 5) + ".face";
+  CHECK(run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + vert.path() + " --quiet").code == 0);
+  CHECK(std::ifstream(face).good());
+  std::remove(face.c_str());
+
+  // Over budget: an error naming the molecule, exit 3, no file.
+  skinmesh::test::TempFile none("none.off");
+  std::remove(none.path().c_str());
+  const Run budget = run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + none.path() + " --max-triangles 500");
+  CHECK(budget.code == 3);
+  CHECK(budget.output.find("pept.pdb") != std::string::npos);
+  CHECK(budget.output.find("budget") != std::string::npos);
+  CHECK_FALSE(std::ifstream(none.path()).good());
+
+  const Run format = run("mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + none.path() + ".xyz");
+  CHECK(format.code != 0);
+  CHECK(format.output.find(".xyz") != std::string::npos);
+  const Run missing = run("mesh /nonexistent/x.pdb -o " + none.path());
+  CHECK(missing.code == 2);
+  CHECK_FALSE(std::ifstream(none.path()).good());
+}
+
+TEST_CASE("skinmesh volume writes VTU, Gmsh and TetGen files with a report", "[cli][volume]") {
+  skinmesh::test::TempFile report("volume.json");
+  const std::string stem = report.path() + ".mesh";
+  const Run r = run("--quiet volume " + skinmesh::test::data_file("pept.pdb") + " -o " + stem +
+                    " --domain both --box-margin 4 --report " + report.path());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  // quality grades the written volume mesh: its boundary is exactly its marked faces.
+  const Run graded = run("--json quality " + stem + ".msh");
+  INFO(graded.output);
+  REQUIRE(graded.code == 0);
+  const nlohmann::json g = nlohmann::json::parse(graded.output);
+  CHECK(g["boundary_faces_not_marked"] == 0);
+  CHECK(g["marked_faces_not_on_boundary"] == 0);
+  CHECK(g["inverted"] == 0);
+  for (const char* ext : {".vtu", ".msh", ".node", ".ele", ".face"}) {
+    std::ifstream in(stem + ext);
+    CHECK(in.good());
+    std::remove((stem + ext).c_str());
+  }
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(report.path()));
+  CHECK(j["inverted"] == 0);
+  CHECK(j["regions"].contains("interior"));
+  CHECK(j["regions"].contains("solvent"));
+  CHECK(j["regions"].contains("cavity"));
+  CHECK(j["interior_volume_relative_difference"].get<double>() <= 1e-9);
+  // What a solver needs to hear: a closed, oriented, manifold skin without
+  // self-intersections (both checks), and elements within the bounds asked.
+  CHECK(j["surface"]["closed"] == true);
+  CHECK(j["surface"]["manifold"] == true);
+  CHECK(j["surface_self_intersections"]["cgal_exact"] == 0);
+  CHECK(j["surface_self_intersections"]["tetgen"] == 0);
+  CHECK(j["bounds_met"] == true);
+  CHECK(j["max_radius_edge_ratio"].get<double>() <= 2.0);
+  CHECK(j["min_dihedral_deg"].get<double>() >= 5.0);
+  CHECK(j["smoothing"]["out_of_bounds_after"] == 0);
+
+  const Run bad = run("volume " + skinmesh::test::data_file("pept.pdb") + " -o " + stem + " --domain inside");
+  CHECK(bad.code != 0);
+  std::ifstream none(stem + ".vtu");
+  CHECK(!none.good());
+}
+
+TEST_CASE("skinmesh interpolate writes the live pairs of B(t) as weighted points", "[cli][interpolation]") {
+  skinmesh::test::TempFile out("mid.wpts");
+  std::remove(out.path().c_str());
+  const std::string pept = skinmesh::test::data_file("pept.pdb"), al1 = skinmesh::test::data_file("3al1.pdb");
+  const Run r = run("--json interpolate " + pept + " " + al1 + " --t 0.25 --centre -o " + out.path());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  const nlohmann::json j = nlohmann::json::parse(r.output);
+  // Read back as a molecule: one ball per live pair, weights as written.
+  const skinmesh::Molecule m = skinmesh::read_molecule(out.path());
+  CHECK(static_cast<long>(m.atoms.size()) == j["balls"].get<long>());
+  CHECK(j["balls"].get<long>() < j["all_pairs"].get<long>());
+  long negative = 0;
+  for (const auto& a : m.atoms) negative += *a.weight < 0;
+  CHECK(negative == j["negative_weights"].get<long>());
+  CHECK(negative > 0);  // weights dip in the middle of a morph
+  // --all-pairs keeps m * n.
+  const Run all = run("--json interpolate " + pept + " " + al1 + " --all-pairs -o " + out.path());
+  REQUIRE(all.code == 0);
+  CHECK(skinmesh::read_molecule(out.path()).atoms.size() == nlohmann::json::parse(all.output)["all_pairs"].get<size_t>());
+  // XYZR cannot hold a negative weight: refused, nothing written.
+  skinmesh::test::TempFile xyzr("mid.xyzr");
+  std::remove(xyzr.path().c_str());
+  const Run refused = run("interpolate " + pept + " " + al1 + " -o " + xyzr.path());
+  CHECK(refused.code != 0);
+  CHECK(refused.output.find(".wpts") != std::string::npos);
+  CHECK(!std::ifstream(xyzr.path()).good());
+}

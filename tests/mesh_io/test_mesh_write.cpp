@@ -1,0 +1,85 @@
+// Every mesh format the tool writes is read back by the tool's own readers
+// (which were written against the format descriptions, not against the writer).
+#include "test_support.hpp"
+
+#include "skinmesh/mesh_io/mesh_read.hpp"
+#include "skinmesh/mesh_io/mesh_write.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <fstream>
+
+using namespace skinmesh;
+using namespace skinmesh::test;
+
+namespace {
+
+SurfaceMesh octahedron() {
+  SurfaceMesh m;
+  // Coordinates that float cannot hold exactly, to see the precision.
+  const double a = 1.0 / 3.0 + 1e-12;
+  m.vertices = {{a, 0, 0}, {-a, 0, 0}, {0, a, 0}, {0, -a, 0}, {0, 0, a}, {0, 0, -a}};
+  m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (const auto& v : m.vertices) m.normals.push_back(v.normalized());
+  m.cells = {0, 1, 2, 3, 4, 5};
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("written meshes read back with the same vertices and triangles", "[io]") {
+  const SurfaceMesh m = octahedron();
+  VertexAttributes attributes;
+  attributes.patch = {0, 1, 2, 3, 0, 1};
+  attributes.atom = {5, 4, 3, 2, 1, 0};
+  for (const char* name : {"m.ply", "m.off", "m.obj", "m.stl", "m.msh"}) {
+    INFO(name);
+    TempFile file(name);
+    {
+      std::ofstream out(file.path(), std::ios::binary);
+      write_mesh(out, m, mesh_format_from_path(name), &attributes);
+    }
+    const SurfaceMesh back = read_surface_mesh(file.path());
+    REQUIRE(back.vertices.size() == m.vertices.size());
+    REQUIRE(back.triangles.size() == m.triangles.size());
+    const bool single = std::string(name) == "m.stl";  // STL holds 32-bit floats only
+    double worst = 0;
+    for (size_t t = 0; t < m.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        worst = std::max(worst, (back.vertices[static_cast<size_t>(back.triangles[t][static_cast<size_t>(k)])] -
+                                 m.vertices[static_cast<size_t>(m.triangles[t][static_cast<size_t>(k)])])
+                                    .norm());
+    if (single)
+      CHECK(worst < 1e-7);
+    else
+      CHECK(worst == 0.0);  // full double precision survives the file
+  }
+  {
+    TempFile vert("m.vert");
+    const std::string face = vert.path().substr(0, vert.path().size() - 5) + ".face";
+    {
+      std::ofstream out(vert.path());
+      write_msms_vert(out, m, &attributes);
+      std::ofstream out_face(face);
+      write_msms_face(out_face, m, &attributes);
+    }
+    const SurfaceMesh back = read_surface_mesh(vert.path());
+    std::remove(face.c_str());
+    REQUIRE(back.vertices.size() == m.vertices.size());
+    CHECK(back.triangles == m.triangles);
+    for (size_t v = 0; v < m.vertices.size(); ++v) CHECK(back.vertices[v] == m.vertices[v]);
+  }
+  {
+    // Single precision is a choice: the PLY then holds floats.
+    TempFile file("f.ply");
+    {
+      std::ofstream out(file.path(), std::ios::binary);
+      MeshWriteOptions o;
+      o.single_precision = true;
+      write_mesh(out, m, MeshFormat::ply, &attributes, o);
+    }
+    const SurfaceMesh back = read_surface_mesh(file.path());
+    CHECK(back.vertices[0][0] == static_cast<double>(static_cast<float>(m.vertices[0][0])));
+  }
+  CHECK_THROWS_AS(mesh_format_from_path("m.xyz"), ContractError);
+}

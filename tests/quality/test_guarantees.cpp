@@ -1,0 +1,69 @@
+// The guarantee check: each guarantee fails on a mesh built to break it and
+// only it, and all hold on the mesher's own mesh. On-skin distances come from
+// the oracle (docs/math.md section 2), never from the mixed complex.
+#include "test_support.hpp"
+
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/quality/guarantees.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace skinmesh;
+
+TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where broken", "[quality][guarantees]") {
+  const auto balls = balls_from_molecule(read_molecule(test::data_file("pept.pdb")), 0.5);
+  const SkinMeshResult r = mesh_skin(build_skin_complex(balls, {0.5}));
+  REQUIRE(r.status == MeshingStatus::ok);
+  const GuaranteeReport good = check_guarantees(r.mesh, balls, 0.5);
+  CHECK(good.all_hold());
+  CHECK(good.surface_error.max <= 1e-9);
+  CHECK(good.quality.min_angle >= 30.0 - 1e-9);
+
+  SECTION("a vertex 0.01 A off the skin") {
+    SurfaceMesh moved = r.mesh;
+    moved.vertices[0] += 0.01 * moved.normals[0];
+    const GuaranteeReport g = check_guarantees(moved, balls, 0.5);
+    CHECK_FALSE(g.on_skin);
+    CHECK(g.surface_error.max == Approx(0.01).epsilon(0.05));
+    CHECK(g.closed_oriented_manifold);
+    CHECK_FALSE(g.all_hold());
+  }
+  SECTION("a triangle turned inside out") {
+    SurfaceMesh flipped = r.mesh;
+    std::swap(flipped.triangles[0][1], flipped.triangles[0][2]);
+    const GuaranteeReport g = check_guarantees(flipped, balls, 0.5);
+    CHECK_FALSE(g.closed_oriented_manifold);
+    CHECK(g.on_skin);
+    CHECK_FALSE(g.all_hold());
+  }
+  SECTION("a hole") {
+    SurfaceMesh open = r.mesh;
+    open.triangles.pop_back();
+    CHECK_FALSE(check_guarantees(open, balls, 0.5).closed_oriented_manifold);
+  }
+  SECTION("a bound the mesh does not meet") {
+    GuaranteeOptions stricter;
+    stricter.min_angle = good.quality.min_angle + 0.5;
+    const GuaranteeReport g = check_guarantees(r.mesh, balls, 0.5, stricter);
+    CHECK_FALSE(g.angle);
+    CHECK(g.on_skin);
+  }
+  SECTION("the self-intersection check skipped is reported as not made") {
+    GuaranteeOptions skip;
+    skip.self_intersections = SelfIntersectionCheck::skip;
+    const GuaranteeReport g = check_guarantees(r.mesh, balls, 0.5, skip);
+    CHECK_FALSE(g.no_self_intersections.has_value());
+    CHECK(g.all_hold());
+  }
+}
+
+TEST_CASE("check_guarantees: two interpenetrating tetrahedra intersect", "[quality][guarantees]") {
+  const SurfaceMesh two = test::two_interpenetrating_tetrahedra();
+  // One ball whose skin the corners are nowhere near: only the topology is asked about here.
+  const GuaranteeReport g = check_guarantees(two, {Ball{Eigen::Vector3d::Zero(), 1.0}}, 0.5);
+  CHECK(g.closed_oriented_manifold);
+  CHECK(g.no_self_intersections == std::optional<bool>(false));
+  CHECK_FALSE(g.on_skin);
+}

@@ -1,0 +1,238 @@
+// Mesh grading against meshes whose answers are known by construction, every
+// reader on the same mesh, and a real skin mesh from CGAL.
+#include "test_support.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/mesh_io/mesh_read.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polyhedron_3.h>
+#include <CGAL/Skin_surface_3.h>
+#include <CGAL/Skin_surface_traits_3.h>
+#include <CGAL/make_skin_surface_mesh_3.h>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+using namespace skinmesh;
+
+namespace {
+
+SurfaceMesh regular_tetrahedron(double a, const Eigen::Vector3d& shift = Eigen::Vector3d::Zero()) {
+  const double h = a / (2 * std::sqrt(2.0));
+  SurfaceMesh m;
+  m.vertices = {Eigen::Vector3d(h, h, h) + shift, Eigen::Vector3d(h, -h, -h) + shift,
+                Eigen::Vector3d(-h, h, -h) + shift, Eigen::Vector3d(-h, -h, h) + shift};
+  m.triangles = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};  // outward
+  return m;
+}
+
+// A torus as an n x m grid of quads, each split in two, oriented outward.
+SurfaceMesh torus(int n, int m, double R, double r) {
+  SurfaceMesh t;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double u = 2 * M_PI * i / n, v = 2 * M_PI * j / m;
+      t.vertices.emplace_back((R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u), r * std::sin(v));
+    }
+  auto id = [&](int i, int j) { return ((i + n) % n) * m + (j + m) % m; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      t.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      t.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return t;
+}
+
+}  // namespace
+
+TEST_CASE("a regular tetrahedron grades as its closed forms say", "[quality]") {
+  const double a = 2.0;
+  const MeshQuality q = grade_mesh(regular_tetrahedron(a));
+  CHECK(q.vertices == 4);
+  CHECK(q.edges == 6);
+  CHECK(q.triangles == 4);
+  CHECK(q.min_angle == Approx(60));
+  CHECK(q.max_angle == Approx(60));
+  CHECK(q.max_radius_edge == Approx(1 / std::sqrt(3.0)));
+  CHECK(q.max_aspect == Approx(1.0));
+  CHECK(q.area == Approx(std::sqrt(3.0) * a * a));
+  CHECK(q.volume == Approx(a * a * a / (6 * std::sqrt(2.0))));
+  CHECK(q.euler == 2);
+  CHECK(q.genus == 0);
+  CHECK(q.components == 1);
+  CHECK((q.closed && q.manifold && q.oriented));
+  CHECK(q.self_intersections_checked);
+  CHECK(q.self_intersecting_pairs == 0);
+  CHECK(q.valence.at(3) == 4);
+}
+
+TEST_CASE("a torus has genus 1 and Euler characteristic 0", "[quality]") {
+  const MeshQuality q = grade_mesh(torus(24, 12, 3.0, 1.0));
+  CHECK(q.euler == 0);
+  CHECK(q.genus == 1);
+  CHECK(q.components == 1);
+  // Inscribed in the smooth torus (volume 2 pi^2 R r^2): a little smaller.
+  CHECK(q.volume < 2 * M_PI * M_PI * 3.0);
+  CHECK(q.volume > 0.9 * 2 * M_PI * M_PI * 3.0);
+  CHECK(q.self_intersecting_pairs == 0);
+}
+
+TEST_CASE("defects are counted: boundary, non-manifold edge, flipped triangle, intersection", "[quality]") {
+  SurfaceMesh open = regular_tetrahedron(1.0);
+  open.triangles.pop_back();
+  const MeshQuality qo = grade_mesh(open);
+  CHECK(qo.boundary_edges == 3);
+  CHECK_FALSE(qo.closed);
+  CHECK(qo.genus == -1);
+
+  SurfaceMesh fin = regular_tetrahedron(1.0);
+  fin.vertices.emplace_back(3, 3, 3);
+  fin.triangles.push_back({0, 1, 4});  // a third triangle on edge 0-1
+  const MeshQuality qf = grade_mesh(fin);
+  CHECK(qf.nonmanifold_edges == 1);
+  CHECK_FALSE(qf.manifold);
+  CHECK_FALSE(qf.self_intersections_checked);
+
+  SurfaceMesh flipped = regular_tetrahedron(1.0);
+  std::swap(flipped.triangles[0][1], flipped.triangles[0][2]);
+  CHECK(grade_mesh(flipped).inconsistent_edges == 3);
+
+  // Two tetrahedra sharing exactly one vertex: a pinch, not a non-manifold edge.
+  SurfaceMesh pinch = regular_tetrahedron(1.0);
+  const SurfaceMesh other = regular_tetrahedron(1.0, pinch.vertices[0] - regular_tetrahedron(1.0).vertices[3] +
+                                                        Eigen::Vector3d::Zero());
+  const int base = static_cast<int>(pinch.vertices.size());
+  for (int k = 0; k < 3; ++k) pinch.vertices.push_back(other.vertices[k]);
+  auto remap = [&](int v) { return v == 3 ? 0 : base + v; };  // other's vertex 3 is pinch's vertex 0
+  for (auto t : other.triangles) pinch.triangles.push_back({remap(t[0]), remap(t[1]), remap(t[2])});
+  const MeshQuality qp = grade_mesh(pinch);
+  CHECK(qp.nonmanifold_vertices == 1);
+  CHECK(qp.nonmanifold_edges == 0);
+  CHECK(qp.components == 1);
+  CHECK_FALSE(qp.manifold);
+
+  SurfaceMesh crossing = regular_tetrahedron(2.0);
+  const SurfaceMesh shifted = regular_tetrahedron(2.0, Eigen::Vector3d(0.3, 0.2, 0.1));
+  for (const auto& v : shifted.vertices) crossing.vertices.push_back(v);
+  for (auto t : shifted.triangles) crossing.triangles.push_back({t[0] + 4, t[1] + 4, t[2] + 4});
+  const MeshQuality qc = grade_mesh(crossing);
+  CHECK(qc.components == 2);
+  REQUIRE(qc.self_intersections_checked);
+  CHECK(qc.self_intersecting_pairs > 0);
+}
+
+TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {
+  const SurfaceMesh t = torus(8, 6, 3.0, 1.0);
+  const MeshQuality expected = grade_mesh(t);
+  std::ostringstream off, obj, stl, ply, vert, face;
+  off.precision(17), obj.precision(17), stl.precision(17), ply.precision(17), vert.precision(17);
+  off << "OFF\n# comment\n" << t.vertices.size() << " " << t.triangles.size() << " 0\n";
+  for (const auto& v : t.vertices) off << v.x() << " " << v.y() << " " << v.z() << "\n", obj << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
+  for (const auto& f : t.triangles) off << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n", obj << "f " << f[0] + 1 << "/1 " << f[1] + 1 << " " << f[2] + 1 << "\n";
+  stl << "solid t\n";
+  for (const auto& f : t.triangles) {
+    stl << "facet normal 0 0 0\nouter loop\n";
+    for (int k = 0; k < 3; ++k) stl << "vertex " << t.vertices[f[k]].x() << " " << t.vertices[f[k]].y() << " " << t.vertices[f[k]].z() << "\n";
+    stl << "endloop\nendfacet\n";
+  }
+  stl << "endsolid t\n";
+  ply << "ply\nformat ascii 1.0\nelement vertex " << t.vertices.size() << "\nproperty double x\nproperty double y\nproperty double z\n"
+      << "element face " << t.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const auto& v : t.vertices) ply << v.x() << " " << v.y() << " " << v.z() << "\n";
+  for (const auto& f : t.triangles) ply << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
+  vert << "# MSMS solvent excluded surface vertices\n" << t.vertices.size() << " 1 1.0 1.5\n";
+  for (const auto& v : t.vertices) vert << v.x() << " " << v.y() << " " << v.z() << " 0 0 1 0 1 1\n";
+  face << "# MSMS faces\n" << t.triangles.size() << " 1 1.0 1.5\n";
+  for (const auto& f : t.triangles) face << f[0] + 1 << " " << f[1] + 1 << " " << f[2] + 1 << " 1 1\n";
+  // Binary PLY (little endian, float) and binary STL.
+  std::string bply = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(t.vertices.size()) +
+                     "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                     std::to_string(t.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string bstl(80, ' ');
+  const uint32_t nf = static_cast<uint32_t>(t.triangles.size());
+  bstl.append(reinterpret_cast<const char*>(&nf), 4);
+  for (const auto& v : t.vertices)
+    for (int k = 0; k < 3; ++k) {
+      const float c = static_cast<float>(v[k]);
+      bply.append(reinterpret_cast<const char*>(&c), 4);
+    }
+  for (const auto& f : t.triangles) {
+    const unsigned char three = 3;
+    bply.append(reinterpret_cast<const char*>(&three), 1);
+    for (int k = 0; k < 3; ++k) bply.append(reinterpret_cast<const char*>(&f[k]), 4);
+    bstl.append(12, '\0');
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) {
+        const float x = static_cast<float>(t.vertices[f[k]][c]);
+        bstl.append(reinterpret_cast<const char*>(&x), 4);
+      }
+    bstl.append(2, '\0');
+  }
+  test::TempFile f_off("t.off", off.str()), f_obj("t.obj", obj.str()), f_stl("t.stl", stl.str()),
+      f_ply("t.ply", ply.str()), f_bply("b.ply", bply), f_bstl("b.stl", bstl), f_vert("m.vert", vert.str());
+  std::ofstream(f_vert.path().substr(0, f_vert.path().size() - 5) + ".face") << face.str();
+  for (const std::string& path : {f_off.path(), f_obj.path(), f_stl.path(), f_ply.path(), f_bply.path(), f_bstl.path(), f_vert.path()}) {
+    INFO(path);
+    const SurfaceMesh read = read_surface_mesh(path);
+    const MeshQuality q = grade_mesh(read);
+    CHECK(q.vertices == expected.vertices);
+    CHECK(q.triangles == expected.triangles);
+    CHECK(q.euler == expected.euler);
+    CHECK(q.volume == Approx(expected.volume).epsilon(1e-6));
+  }
+  std::remove((f_vert.path().substr(0, f_vert.path().size() - 5) + ".face").c_str());
+}
+
+TEST_CASE("bad mesh files are reported with file and line", "[quality][io][bad]") {
+  test::TempFile bad_index("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  try {
+    read_surface_mesh(bad_index.path());
+    FAIL("no error");
+  } catch (const InputError& e) {
+    CHECK(e.line() == 6);
+    CHECK(std::string(e.what()).find("vertex 7") != std::string::npos);
+  }
+  test::TempFile nan("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  CHECK_THROWS_AS(read_surface_mesh(nan.path()), InputError);
+  test::TempFile short_stl("s.stl", std::string(90, '\0'));
+  CHECK_THROWS_AS(read_surface_mesh(short_stl.path()), InputError);
+  CHECK_THROWS_AS(read_surface_mesh("/nonexistent.off"), InputError);
+  test::TempFile unknown("m.xyz", "1 2 3");
+  CHECK_THROWS_AS(read_surface_mesh(unknown.path()), InputError);
+}
+
+TEST_CASE("CGAL's skin mesh of pept: closed, manifold, oriented, no self-intersections", "[quality][cgal]") {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  const auto balls = balls_from_molecule(read_molecule(test::data_file("pept.pdb")), 0.5);
+  std::vector<K::Weighted_point_3> wp;
+  for (const Ball& b : balls) wp.emplace_back(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight);
+  CGAL::Polyhedron_3<K> poly;
+  CGAL::make_skin_surface_mesh_3(poly, wp.begin(), wp.end(), 0.5, 0, false);
+  SurfaceMesh mesh;
+  std::map<const void*, int> index;
+  for (auto v = poly.vertices_begin(); v != poly.vertices_end(); ++v) {
+    index[&*v] = static_cast<int>(mesh.vertices.size());
+    mesh.vertices.emplace_back(v->point().x(), v->point().y(), v->point().z());
+  }
+  for (auto f = poly.facets_begin(); f != poly.facets_end(); ++f) {
+    auto h = f->facet_begin();
+    std::array<int, 3> t{};
+    for (int k = 0; k < 3; ++k, ++h) t[k] = index[&*h->vertex()];
+    mesh.triangles.push_back(t);
+  }
+  const MeshQuality q = grade_mesh(mesh);
+  CHECK((q.closed && q.manifold && q.oriented));
+  CHECK(q.volume > 0);
+  CHECK(q.euler % 2 == 0);
+  CHECK(q.genus >= 0);
+  REQUIRE(q.self_intersections_checked);
+  CHECK(q.self_intersecting_pairs == 0);
+}
