@@ -24,95 +24,112 @@ namespace skinmesh::app {
 
 using json = nlohmann::json;
 
-void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_code) {
-  struct Options {
-    std::string mesh;
-    std::string svg;
-    bool no_self_intersections = false;
-    bool tetgen = false;
-    MoleculeOptions molecule;
+namespace {
+
+struct QualityCommandOptions {
+  std::string mesh;
+  std::string svg;
+  bool no_self_intersections = false;
+  bool tetgen = false;
+  MoleculeOptions molecule;
+};
+
+void add_quality_options(CLI::App& cmd, QualityCommandOptions& o) {
+  cmd.add_option("mesh", o.mesh, "mesh file")->required();
+  cmd.add_option("--molecule", o.molecule.path, "also measure each vertex's distance to this molecule's skin");
+  cmd.add_option("--svg", o.svg, "write a histogram of the smallest angles as SVG");
+  cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
+  cmd.add_flag("--tetgen", o.tetgen, "also count self-intersections with TetGen's -d check (a second opinion)");
+  add_molecule_settings(cmd, o.molecule);
+}
+
+void grade_tets(const std::string& file, const TetMesh& tets, const GlobalOptions& global) {
+  const TetQuality q = grade_tet_mesh(tets);
+  json report = tet_report(tets, q);
+  report["file"] = file;
+  if (global.json) {
+    std::cout << report.dump(2) << "\n";
+    return;
+  }
+  std::cout << file << ": " << q.points << " points, " << q.tets << " tetrahedra, volume " << q.volume << " A^3\n";
+  print_tet_quality(std::cout, q);
+  for (const auto& [r, v] : report["regions"].items())
+    std::cout << "  region " << r << ": " << v["tetrahedra"].get<long>() << " tetrahedra, volume "
+              << v["volume"].get<double>() << " A^3\n";
+  std::cout << "  boundary:        " << report["boundary_faces"].get<long>() << " faces; "
+            << report["boundary_faces_not_marked"].get<long>() << " not among the marked faces, "
+            << report["marked_faces_not_on_boundary"].get<long>() << " marked faces not on a boundary\n";
+}
+
+void grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, const GlobalOptions& global) {
+  GradeOptions grade;
+  grade.self_intersections = o.no_self_intersections ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
+  const MeshQuality q = grade_mesh(mesh, grade);
+  json report = to_json(q);
+  report["file"] = o.mesh;
+  if (o.tetgen) {
+    const long pairs = tetgen_self_intersections(mesh);
+    report["tetgen_self_intersecting_pairs"] = pairs >= 0 ? json(pairs) : json(nullptr);
+  }
+  if (!o.molecule.path.empty()) {
+    const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
+    const auto balls = balls_from_molecule(m, o.molecule.shrink, o.molecule.convention());
+    json error = to_json(on_surface_error(mesh.vertices, balls, o.molecule.shrink));
+    error["molecule"] = o.molecule.path;
+    error["shrink"] = o.molecule.shrink;
+    error["weights"] = convention_name(o.molecule.convention());
+    report["on_surface_error"] = error;
+  }
+  if (!o.svg.empty()) write_file_atomically(o.svg, [&](std::ostream& out) { write_svg(out, q, o.mesh); });
+  if (global.json) {
+    std::cout << report.dump(2) << "\n";
+    return;
+  }
+  print_quality_summary(std::cout, o.mesh, q);
+  if (report.contains("tetgen_self_intersecting_pairs"))
+    std::cout << "  TetGen -d:   "
+              << (report["tetgen_self_intersecting_pairs"].is_null()
+                      ? std::string("could not be run")
+                      : std::to_string(report["tetgen_self_intersecting_pairs"].get<long>()) + " intersecting pairs")
+              << "\n";
+  if (report.contains("on_surface_error"))
+    std::cout << "  on-surface error: max " << report["on_surface_error"]["max"].get<double>() << " A, mean "
+              << report["on_surface_error"]["mean"].get<double>() << " A (oracle, " << o.molecule.path << ")\n";
+}
+
+// Tetrahedral meshes (TetGen's files, or a Gmsh file with tetrahedra) are
+// graded as volumes, everything else as a surface; a Gmsh file is read once,
+// whichever it holds.
+ExitCode run_quality(const QualityCommandOptions& o, const GlobalOptions& global) {
+  const auto ends_with = [&](const std::string& ext) {
+    return o.mesh.size() > ext.size() && o.mesh.compare(o.mesh.size() - ext.size(), std::string::npos, ext) == 0;
   };
-  auto o = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("quality", "grade a triangle mesh (OFF, PLY, OBJ, STL, Gmsh, MSMS .vert/.face) or a tetrahedral one (TetGen .node/.ele, Gmsh)");
-  cmd->add_option("mesh", o->mesh, "mesh file")->required();
-  cmd->add_option("--molecule", o->molecule.path, "also measure each vertex's distance to this molecule's skin");
-  cmd->add_option("--svg", o->svg, "write a histogram of the smallest angles as SVG");
-  cmd->add_flag("--no-self-intersections", o->no_self_intersections, "skip the exact self-intersection check");
-  cmd->add_flag("--tetgen", o->tetgen, "also count self-intersections with TetGen's -d check (a second opinion)");
-  add_molecule_settings(*cmd, o->molecule);
-  cmd->callback([o, &global, &exit_code]() {
-    // Tetrahedral meshes (TetGen's files, or a Gmsh file with tetrahedra); a
-    // Gmsh file is read once, whichever it holds.
-    const auto ends_with = [&](const std::string& ext) {
-      return o->mesh.size() > ext.size() && o->mesh.compare(o->mesh.size() - ext.size(), std::string::npos, ext) == 0;
-    };
-    std::optional<TetMesh> gmsh;
-    if (ends_with(".msh")) gmsh = read_gmsh_volume(o->mesh);
-    const bool tetgen_files = ends_with(".node") || ends_with(".ele");
-    if (tetgen_files || (gmsh && !gmsh->tets.empty())) {
-      const TetMesh tets = tetgen_files ? read_tet_mesh(o->mesh) : std::move(*gmsh);
-      const TetQuality q = grade_tet_mesh(tets);
-      json report = tet_report(tets, q);
-      report["file"] = o->mesh;
-      if (global.json) {
-        std::cout << report.dump(2) << "\n";
-      } else {
-        std::cout << o->mesh << ": " << q.points << " points, " << q.tets << " tetrahedra, volume " << q.volume
-                  << " A^3\n";
-        print_tet_quality(std::cout, q);
-        for (const auto& [r, v] : report["regions"].items())
-          std::cout << "  region " << r << ": " << v["tetrahedra"].get<long>() << " tetrahedra, volume "
-                    << v["volume"].get<double>() << " A^3\n";
-        std::cout << "  boundary:        " << report["boundary_faces"].get<long>() << " faces; "
-                  << report["boundary_faces_not_marked"].get<long>() << " not among the marked faces, "
-                  << report["marked_faces_not_on_boundary"].get<long>() << " marked faces not on a boundary\n";
-      }
-      exit_code = code(ExitCode::ok);
-      return;
-    }
-    SurfaceMesh mesh;
-    if (gmsh) {
-      if (gmsh->faces.empty()) input_error(o->mesh, 0, "mesh has no triangles");
-      mesh.vertices = std::move(gmsh->points);
-      mesh.triangles = std::move(gmsh->faces);
-    } else {
-      mesh = read_surface_mesh(o->mesh);
-    }
-    GradeOptions grade;
-    grade.self_intersections = o->no_self_intersections ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
-    const MeshQuality q = grade_mesh(mesh, grade);
-    json report = to_json(q);
-    report["file"] = o->mesh;
-    if (o->tetgen) {
-      const long pairs = tetgen_self_intersections(mesh);
-      report["tetgen_self_intersecting_pairs"] = pairs >= 0 ? json(pairs) : json(nullptr);
-    }
-    if (!o->molecule.path.empty()) {
-      const Molecule m = read_molecule(o->molecule.path, o->molecule.read);
-      const auto balls = balls_from_molecule(m, o->molecule.shrink, o->molecule.convention());
-      json error = to_json(on_surface_error(mesh.vertices, balls, o->molecule.shrink));
-      error["molecule"] = o->molecule.path;
-      error["shrink"] = o->molecule.shrink;
-      error["weights"] = convention_name(o->molecule.convention());
-      report["on_surface_error"] = error;
-    }
-    if (!o->svg.empty()) write_file_atomically(o->svg, [&](std::ostream& out) { write_svg(out, q, o->mesh); });
-    if (global.json) {
-      std::cout << report.dump(2) << "\n";
-    } else {
-      print_quality_summary(std::cout, o->mesh, q);
-      if (report.contains("tetgen_self_intersecting_pairs"))
-        std::cout << "  TetGen -d:   "
-                  << (report["tetgen_self_intersecting_pairs"].is_null()
-                          ? std::string("could not be run")
-                          : std::to_string(report["tetgen_self_intersecting_pairs"].get<long>()) + " intersecting pairs")
-                  << "\n";
-      if (report.contains("on_surface_error"))
-        std::cout << "  on-surface error: max " << report["on_surface_error"]["max"].get<double>() << " A, mean "
-                  << report["on_surface_error"]["mean"].get<double>() << " A (oracle, " << o->molecule.path << ")\n";
-    }
-    exit_code = code(ExitCode::ok);
-  });
+  std::optional<TetMesh> gmsh;
+  if (ends_with(".msh")) gmsh = read_gmsh_volume(o.mesh);
+  const bool tetgen_files = ends_with(".node") || ends_with(".ele");
+  if (tetgen_files || (gmsh && !gmsh->tets.empty())) {
+    grade_tets(o.mesh, tetgen_files ? read_tet_mesh(o.mesh) : std::move(*gmsh), global);
+    return ExitCode::ok;
+  }
+  SurfaceMesh mesh;
+  if (gmsh) {
+    if (gmsh->faces.empty()) input_error(o.mesh, 0, "mesh has no triangles");
+    mesh.vertices = std::move(gmsh->points);
+    mesh.triangles = std::move(gmsh->faces);
+  } else {
+    mesh = read_surface_mesh(o.mesh);
+  }
+  grade_surface(o, mesh, global);
+  return ExitCode::ok;
+}
+
+}  // namespace
+
+void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_code) {
+  add_command(app, "quality",
+              "grade a triangle mesh (OFF, PLY, OBJ, STL, Gmsh, MSMS .vert/.face) or a tetrahedral one (TetGen "
+              ".node/.ele, Gmsh)",
+              global, exit_code, add_quality_options, run_quality);
 }
 
 }  // namespace skinmesh::app

@@ -24,9 +24,13 @@ using Regular = detail::RegularTriangulation<int>;
 
 using Key = std::array<int, 4>;  // ascending ball indices, padded with -1
 
+// The first `count` ids ascending, the rest -1 (an insertion sort: std::sort
+// on four ints draws a false -Warray-bounds from GCC 12).
 Key make_key(std::array<int, 4> ids, int count) {
-  std::sort(ids.begin(), ids.begin() + count);
-  for (int i = count; i < 4; ++i) ids[i] = -1;
+  for (int i = 1; i < count; ++i)
+    for (int j = i; j > 0 && ids[static_cast<size_t>(j - 1)] > ids[static_cast<size_t>(j)]; --j)
+      std::swap(ids[static_cast<size_t>(j - 1)], ids[static_cast<size_t>(j)]);
+  for (int i = count; i < 4; ++i) ids[static_cast<size_t>(i)] = -1;
   return ids;
 }
 
@@ -188,11 +192,9 @@ struct SkinComplexBuilder {
     if (rt.dimension() == 3)
       for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c)
         add({c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()}, 4);
-    // The tuple -> cell lookup (find_cell): indices ordered by tuple.
-    sc.cells_by_balls_.resize(cells.size());
-    std::iota(sc.cells_by_balls_.begin(), sc.cells_by_balls_.end(), 0);
-    std::sort(sc.cells_by_balls_.begin(), sc.cells_by_balls_.end(),
-              [&](int x, int y) { return cells[static_cast<size_t>(x)].balls < cells[static_cast<size_t>(y)].balls; });
+    // The tuple -> cell lookup (find_cell).
+    sc.cell_of_balls_.reserve(cells.size() * 2);
+    for (size_t i = 0; i < cells.size(); ++i) sc.cell_of_balls_.emplace(cells[i].balls, static_cast<int>(i));
   }
 
   // Faces (drop one ball) and cofaces (add one ball) of every cell, in CSR form.

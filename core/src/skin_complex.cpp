@@ -92,10 +92,8 @@ int SkinComplex::find_cell(std::array<int, 4> balls) const {
       if (!(a < 0 ? b >= 0 : b >= 0 && b < a)) break;
       std::swap(balls[j - 1], balls[j]);
     }
-  const auto it = std::lower_bound(cells_by_balls_.begin(), cells_by_balls_.end(), balls,
-                                   [&](int c, const std::array<int, 4>& key) { return cells_[static_cast<size_t>(c)].balls < key; });
-  if (it == cells_by_balls_.end() || cells_[static_cast<size_t>(*it)].balls != balls) return -1;
-  return *it;
+  const auto it = cell_of_balls_.find(balls);
+  return it == cell_of_balls_.end() ? -1 : it->second;
 }
 
 std::array<int, 3> SkinComplex::grid_cell_of(const Eigen::Vector3d& x) const {

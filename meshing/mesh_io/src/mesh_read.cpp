@@ -202,63 +202,66 @@ SurfaceMesh read_stl(const std::string& path) {
   return mesh;
 }
 
-SurfaceMesh read_ply(const std::string& path) {
-  const std::string data = read_all(path);
+struct PlyProperty {
+  std::string name, type, count_type;  // count_type non-empty for lists
+};
+struct PlyElement {
+  std::string name;
+  long count = 0;
+  std::vector<PlyProperty> properties;
+};
+struct PlyHeader {
+  std::string format;  // ascii, binary_little_endian or binary_big_endian
+  std::vector<PlyElement> elements;
+  size_t body = 0;     // offset of the first byte after the header
+};
+
+PlyHeader read_ply_header(const std::string& data, const std::string& path) {
   const size_t end_header = data.find("end_header");
   if (data.compare(0, 3, "ply") != 0 || end_header == std::string::npos) input_error(path, 1, "not a PLY file");
-  size_t body = data.find('\n', end_header);
-  body = body == std::string::npos ? data.size() : body + 1;
-  struct Property {
-    std::string name, type, count_type;  // count_type non-empty for lists
-  };
-  struct Element {
-    std::string name;
-    long count = 0;
-    std::vector<Property> properties;
-  };
-  std::vector<Element> elements;
-  std::string format;
+  PlyHeader h;
+  h.body = data.find('\n', end_header);
+  h.body = h.body == std::string::npos ? data.size() : h.body + 1;
   for_each_tagged_line(data.substr(0, end_header), [&](long number, const std::string& tag, std::istringstream& w) {
     if (tag == "format") {
-      w >> format;
+      w >> h.format;
     } else if (tag == "element") {
-      Element e;
+      PlyElement e;
       w >> e.name >> e.count;
-      elements.push_back(e);
+      h.elements.push_back(e);
     } else if (tag == "property") {
-      if (elements.empty()) input_error(path, number, "property before any element");
-      Property p;
+      if (h.elements.empty()) input_error(path, number, "property before any element");
+      PlyProperty p;
       w >> p.type;
       if (p.type == "list") w >> p.count_type >> p.type;
       w >> p.name;
-      elements.back().properties.push_back(p);
+      h.elements.back().properties.push_back(p);
     }
   });
-  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-    input_error(path, 2, "unknown PLY format '" + format + "'");
-  const bool ascii = format == "ascii";
-  const bool swap = format == "binary_big_endian";
-  auto size_of = [&](const std::string& t) -> size_t {
-    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-    if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
-    if (t == "double" || t == "float64") return 8;
-    input_error(path, 0, "unknown PLY property type '" + t + "'");
-  };
-  size_t pos = body;
-  std::istringstream text(ascii ? data.substr(body) : std::string());
-  auto read_value = [&](const std::string& type) -> double {
-    if (ascii) {
+  if (h.format != "ascii" && h.format != "binary_little_endian" && h.format != "binary_big_endian")
+    input_error(path, 2, "unknown PLY format '" + h.format + "'");
+  return h;
+}
+
+// The values of a PLY body one after another, as doubles, in its format.
+class PlyValues {
+ public:
+  PlyValues(const std::string& data, const PlyHeader& header, const std::string& path)
+      : data_(data), path_(path), ascii_(header.format == "ascii"), swap_(header.format == "binary_big_endian"),
+        pos_(header.body), text_(ascii_ ? data.substr(header.body) : std::string()) {}
+
+  double next(const std::string& type) {
+    if (ascii_) {
       double v;
-      if (!(text >> v)) input_error(path, 0, "PLY body ends early or holds a non-number");
+      if (!(text_ >> v)) input_error(path_, 0, "PLY body ends early or holds a non-number");
       return v;
     }
     const size_t n = size_of(type);
-    if (pos + n > data.size()) input_error(path, 0, "PLY body ends early");
+    if (pos_ + n > data_.size()) input_error(path_, 0, "PLY body ends early");
     unsigned char b[8];
-    std::memcpy(b, data.data() + pos, n);
-    pos += n;
-    if (swap) std::reverse(b, b + n);
+    std::memcpy(b, data_.data() + pos_, n);
+    pos_ += n;
+    if (swap_) std::reverse(b, b + n);
     if (type == "float" || type == "float32") { float f; std::memcpy(&f, b, 4); return f; }
     if (type == "double" || type == "float64") { double d; std::memcpy(&d, b, 8); return d; }
     if (type == "char" || type == "int8") return static_cast<int8_t>(b[0]);
@@ -269,21 +272,42 @@ SurfaceMesh read_ply(const std::string& path) {
     uint32_t v;
     std::memcpy(&v, b, 4);
     return v;
-  };
+  }
+
+ private:
+  size_t size_of(const std::string& t) const {
+    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+    if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
+    if (t == "double" || t == "float64") return 8;
+    input_error(path_, 0, "unknown PLY property type '" + t + "'");
+  }
+
+  const std::string& data_;
+  const std::string& path_;
+  bool ascii_, swap_;
+  size_t pos_;
+  std::istringstream text_;
+};
+
+SurfaceMesh read_ply(const std::string& path) {
+  const std::string data = read_all(path);
+  const PlyHeader header = read_ply_header(data, path);
+  PlyValues values(data, header, path);
   SurfaceMesh mesh;
-  for (const Element& e : elements) {
+  for (const PlyElement& e : header.elements) {
     for (long i = 0; i < e.count; ++i) {
       double xyz[3] = {NAN, NAN, NAN};
       std::vector<long> corners;
-      for (const Property& p : e.properties) {
+      for (const PlyProperty& p : e.properties) {
         if (!p.count_type.empty()) {
-          const long n = static_cast<long>(read_value(p.count_type));
+          const long n = static_cast<long>(values.next(p.count_type));
           for (long k = 0; k < n; ++k) {
-            const double v = read_value(p.type);
+            const double v = values.next(p.type);
             if (e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index")) corners.push_back(static_cast<long>(v));
           }
         } else {
-          const double v = read_value(p.type);
+          const double v = values.next(p.type);
           if (e.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z")) xyz[p.name[0] - 'x'] = v;
         }
       }

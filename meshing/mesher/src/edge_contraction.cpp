@@ -95,18 +95,12 @@ bool Refiner::try_contract(Vertex_handle a, Vertex_handle b, const Projection& t
   return false;
 }
 
-long Refiner::contract_short_edges(const std::vector<FacetEval>& restricted) {
-  const unsigned pass_stamp = stamp_;
-  FacetSet restricted_before;
-  struct Candidate {
-    double length;
-    Vertex_handle a, b;
-    int ida, idb;  // to test before touching the handles, which removal may have freed
-  };
-  std::vector<Candidate> candidates;
+// The restricted edges shorter than contract_below times the smaller target
+// length at their ends, shortest first.
+std::vector<ShortEdge> Refiner::short_edges(const std::vector<FacetEval>& restricted) const {
+  std::vector<ShortEdge> candidates;
   std::unordered_set<long long> listed;
-  for (const FacetEval& e : restricted) {
-    restricted_before.insert(facet_key(e));
+  for (const FacetEval& e : restricted)
     for (int k = 0; k < 3; ++k) {
       Vertex_handle a = e.v[static_cast<size_t>(k)], b = e.v[static_cast<size_t>((k + 1) % 3)];
       if (a->info().id > b->info().id) std::swap(a, b);
@@ -118,9 +112,16 @@ long Refiner::contract_short_edges(const std::vector<FacetEval>& restricted) {
                                                               target_edge_length(complex_, pb, b->info().cell, options_));
       if (length < lower) candidates.push_back({length, a, b, a->info().id, b->info().id});
     }
-  }
   std::sort(candidates.begin(), candidates.end(),
-            [](const Candidate& x, const Candidate& y) { return x.length < y.length; });
+            [](const ShortEdge& x, const ShortEdge& y) { return x.length < y.length; });
+  return candidates;
+}
+
+long Refiner::contract_short_edges(const std::vector<FacetEval>& restricted) {
+  const unsigned pass_stamp = stamp_;
+  FacetSet restricted_before;
+  for (const FacetEval& e : restricted) restricted_before.insert(facet_key(e));
+  const std::vector<ShortEdge> candidates = short_edges(restricted);
   // The surface fan the contraction would make: the new point joined to the
   // link edges of both ends. If one of its triangles is already too thin the
   // restricted Delaunay triangles will be too (they are that fan, or a
@@ -133,7 +134,7 @@ long Refiner::contract_short_edges(const std::vector<FacetEval>& restricted) {
     add_to_links(ids, LinkScope::every_vertex, link);
     for (size_t k = 0; k < 3; ++k) position.emplace(ids[k], to_eigen(e.v[k]->point()));
   }
-  auto fan_is_good = [&](const Candidate& c, const Eigen::Vector3d& m) {
+  auto fan_is_good = [&](const ShortEdge& c, const Eigen::Vector3d& m) {
     for (const auto& [end, other] : {std::pair<int, int>{c.ida, c.idb}, std::pair<int, int>{c.idb, c.ida}}) {
       for (const auto& [x, y] : link[end]) {
         if (x == other || y == other) continue;
@@ -151,7 +152,7 @@ long Refiner::contract_short_edges(const std::vector<FacetEval>& restricted) {
 
   std::unordered_set<int> touched;
   long contracted = 0;
-  for (const Candidate& c : candidates) {
+  for (const ShortEdge& c : candidates) {
     // Untouched vertices keep their handles (removals never move other vertices).
     if (touched.count(c.ida) || touched.count(c.idb)) continue;
     Cell_handle cell;

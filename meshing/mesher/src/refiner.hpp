@@ -66,6 +66,14 @@ struct FacetEval {
   unsigned stamp_c = 0, stamp_n = 0; // of the two cells when evaluated
 };
 
+// A Voronoi edge dual to a Delaunay facet, from a to b along the facet's
+// normal, and the apexes of the facet's two tetrahedra (none beyond the hull).
+struct DualEdge {
+  Eigen::Vector3d a, b;
+  Eigen::Vector3d apex_c;
+  std::optional<Eigen::Vector3d> apex_n;
+};
+
 // Whether the link of a vertex (the opposite edges of its restricted
 // triangles) is one closed cycle: the vertex star is a disk.
 bool is_single_cycle(const std::vector<std::pair<int, int>>& edges);
@@ -110,6 +118,13 @@ inline void add_to_links(const FacetKey& ids, LinkScope scope, Links& links) {
     it->second.emplace_back(ids[(k + 1) % 3], ids[(k + 2) % 3]);
   }
 }
+
+// A restricted edge the clean-up may contract.
+struct ShortEdge {
+  double length;
+  Vertex_handle a, b;
+  int ida, idb;  // to test before touching the handles, which removal may have freed
+};
 
 // How the refiner reports progress: at once, or at most every quarter second.
 enum class Report { now, throttled };
@@ -158,6 +173,8 @@ class Refiner {
   }
 
   FacetEval evaluate(const Facet& facet) const;
+  std::optional<DualEdge> dual_edge(Cell_handle c, int i, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                                    const Eigen::Vector3d& p2) const;
   void insert_seeds();
   Vertex_handle insert(const Eigen::Vector3d& p, int cell, Cell_handle hint);
   void push_if_bad(const FacetEval& e);
@@ -174,6 +191,7 @@ class Refiner {
 
   // Clean-up (edge_contraction.cpp).
   long contract_short_edges(const std::vector<FacetEval>& restricted);
+  std::vector<ShortEdge> short_edges(const std::vector<FacetEval>& restricted) const;
   bool try_contract(Vertex_handle a, Vertex_handle b, const Projection& target, unsigned pass_stamp,
                     const FacetSet& restricted_before, std::unordered_set<int>* touched);
   bool region_is_good(const std::vector<Vertex_handle>& region, unsigned pass_stamp,

@@ -9,6 +9,46 @@
 
 namespace skinmesh::detail {
 
+// The Voronoi edge dual to facet i of cell c (triangle p0 p1 p2), walked
+// along the triangle's normal. It lies on the line through the triangle's
+// circumcentre along its normal. Computing it from the triangle, and only the
+// parameters of its ends from the two tetrahedra, keeps it accurate when a
+// tetrahedron is flat (nearly cocircular samples, common on sphere patches)
+// and its circumcentre is ill-conditioned: every point found on it is then
+// truly equidistant from the triangle's vertices. Empty for collinear samples.
+std::optional<DualEdge> Refiner::dual_edge(Cell_handle c, int i, const Eigen::Vector3d& p0,
+                                           const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) const {
+  const Eigen::Vector3d u = p1 - p0, w = p2 - p0;
+  const Eigen::Vector3d uxw = u.cross(w);
+  const double cross2 = uxw.squaredNorm();
+  if (!(cross2 > 0)) return std::nullopt;
+  const Eigen::Vector3d circumcenter = p0 + (u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)) / (2.0 * cross2);
+  const Eigen::Vector3d normal = uxw / std::sqrt(cross2);
+  const double circumradius2 = (circumcenter - p0).squaredNorm();
+  const double reach = (circumcenter - box_center_).norm() + box_radius_;
+  // Parameter along `normal` of the circumcentre of the tetrahedron with apex q.
+  auto end_parameter = [&](const Eigen::Vector3d& q) {
+    const double height = normal.dot(q - circumcenter);
+    const double numerator = (q - circumcenter).squaredNorm() - circumradius2;
+    if (std::abs(numerator) >= 2.0 * reach * std::abs(height)) return std::copysign(reach, numerator * height);
+    return numerator / (2.0 * height);
+  };
+  DualEdge edge;
+  edge.apex_c = to_eigen(c->vertex(i)->point());
+  double lambda_c = end_parameter(edge.apex_c), lambda_n;
+  const Cell_handle n = c->neighbor(i);
+  if (dt_.is_infinite(n)) {
+    // Convex hull facet: the Voronoi edge is a ray leaving the hull.
+    lambda_n = normal.dot(edge.apex_c - circumcenter) > 0 ? -reach : reach;
+  } else {
+    edge.apex_n = to_eigen(n->vertex(n->index(c))->point());
+    lambda_n = end_parameter(*edge.apex_n);
+  }
+  edge.a = circumcenter + std::min(lambda_c, lambda_n) * normal;
+  edge.b = circumcenter + std::max(lambda_c, lambda_n) * normal;
+  return edge;
+}
+
 FacetEval Refiner::evaluate(const Facet& facet) const {
   Cell_handle c = facet.first;
   int i = facet.second;
@@ -27,41 +67,9 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
   std::sort(e.v.begin(), e.v.end(), [](Vertex_handle x, Vertex_handle y) { return x->info().id < y->info().id; });
   const Eigen::Vector3d p0 = to_eigen(e.v[0]->point()), p1 = to_eigen(e.v[1]->point()),
                         p2 = to_eigen(e.v[2]->point());
-  // The Voronoi edge lies on the line through the triangle's circumcentre along
-  // its normal. Computing it from the triangle, and only the parameters of its
-  // ends from the two tetrahedra, keeps it accurate when a tetrahedron is flat
-  // (nearly cocircular samples, common on sphere patches) and its circumcentre
-  // is ill-conditioned: every point found on it is then truly equidistant from
-  // the triangle's vertices.
-  const Eigen::Vector3d u = p1 - p0, w = p2 - p0;
-  const Eigen::Vector3d uxw = u.cross(w);
-  const double cross2 = uxw.squaredNorm();
-  if (!(cross2 > 0)) return e;  // collinear samples: no triangle, nothing to test
-  const Eigen::Vector3d circumcenter = p0 + (u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)) / (2.0 * cross2);
-  const Eigen::Vector3d normal = uxw / std::sqrt(cross2);
-  const double circumradius2 = (circumcenter - p0).squaredNorm();
-  const double reach = (circumcenter - box_center_).norm() + box_radius_;
-  // Parameter along `normal` of the circumcentre of the tetrahedron with apex q.
-  auto end_parameter = [&](const Eigen::Vector3d& q) {
-    const double height = normal.dot(q - circumcenter);
-    const double numerator = (q - circumcenter).squaredNorm() - circumradius2;
-    if (std::abs(numerator) >= 2.0 * reach * std::abs(height)) return std::copysign(reach, numerator * height);
-    return numerator / (2.0 * height);
-  };
-  const Eigen::Vector3d apex_c = to_eigen(c->vertex(i)->point());
-  double lambda_c = end_parameter(apex_c), lambda_n;
-  const Cell_handle n = c->neighbor(i);
-  std::optional<Eigen::Vector3d> apex_n;
-  if (dt_.is_infinite(n)) {
-    // Convex hull facet: the Voronoi edge is a ray leaving the hull.
-    lambda_n = normal.dot(apex_c - circumcenter) > 0 ? -reach : reach;
-  } else {
-    apex_n = to_eigen(n->vertex(n->index(c))->point());
-    lambda_n = end_parameter(*apex_n);
-  }
-  const Eigen::Vector3d a = circumcenter + std::min(lambda_c, lambda_n) * normal,
-                        b = circumcenter + std::max(lambda_c, lambda_n) * normal;
-  auto hits = complex_.intersect_segment(a, b, e.v[0]->info().cell);
+  const std::optional<DualEdge> edge = dual_edge(c, i, p0, p1, p2);
+  if (!edge) return e;  // collinear samples: no triangle, nothing to test
+  auto hits = complex_.intersect_segment(edge->a, edge->b, e.v[0]->info().cell);
   // A point inside the Voronoi edge is strictly nearer to the triangle's
   // vertices than to either apex. When a tetrahedron is flat (its apex
   // cocircular with the triangle, which refinement on sphere patches does
@@ -71,12 +79,13 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
   hits.erase(std::remove_if(hits.begin(), hits.end(),
                             [&](const SegmentCrossing& h) {
                               const double r2 = (h.point - p0).squaredNorm() * (1 + 1e-7);
-                              return (h.point - apex_c).squaredNorm() < r2 ||
-                                     (apex_n && (h.point - *apex_n).squaredNorm() < r2);
+                              return (h.point - edge->apex_c).squaredNorm() < r2 ||
+                                     (edge->apex_n && (h.point - *edge->apex_n).squaredNorm() < r2);
                             }),
              hits.end());
   e.crossings = static_cast<int>(hits.size());
   if (hits.empty()) return e;
+  // The surface Delaunay ball: of several crossings, the largest.
   size_t best = 0;
   double best_r2 = -1;
   for (size_t k = 0; k < hits.size(); ++k) {
@@ -89,7 +98,7 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
   e.center = hits[best].point;
   e.cell = hits[best].cell;
   e.radius = std::sqrt(best_r2);
-  e.outward = hits[best].entering ? (a - b) : (b - a);
+  e.outward = hits[best].entering ? (edge->a - edge->b) : (edge->b - edge->a);
   RestrictedTriangle triangle;
   triangle.corners = {p0, p1, p2};
   triangle.ball_center = e.center;

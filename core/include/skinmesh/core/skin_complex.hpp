@@ -16,6 +16,7 @@
 
 #include <array>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 namespace skinmesh {
@@ -146,7 +147,14 @@ class SkinComplex {
   std::vector<int> face_offset_, faces_;
   std::vector<int> coface_offset_;
   std::vector<Coface> cofaces_;
-  std::vector<int> cells_by_balls_;  // cell indices ordered by their ball tuples (find_cell)
+  struct BallTupleHash {
+    size_t operator()(const std::array<int, 4>& k) const {
+      size_t h = 1469598103934665603ull;  // FNV-1a over the four ids
+      for (int v : k) h = (h ^ static_cast<size_t>(v + 1)) * 1099511628211ull;
+      return h;
+    }
+  };
+  std::unordered_map<std::array<int, 4>, int, BallTupleHash> cell_of_balls_;  // ball tuple -> cell (find_cell)
   // Uniform grid over the centres of the non-hidden balls: a start for walks.
   Eigen::Vector3d grid_origin_ = Eigen::Vector3d::Zero();
   double grid_step_ = 1.0;
