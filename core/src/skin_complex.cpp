@@ -343,8 +343,9 @@ static CellExit segment_exit(const SkinComplex& sc, int c, const Eigen::Vector3d
       slope0 -= A1[j];
     }
     const int* faces = sc.faces_begin(c);
-    consider(bary0, slope0, faces[0], false);
-    for (int j = 1; j <= cell.dim; ++j) consider(A0[j - 1], A1[j - 1], faces[j], false);
+    const bool past_flat_coface = false;  // a face is always adjacent
+    consider(bary0, slope0, faces[0], past_flat_coface);
+    for (int j = 1; j <= cell.dim; ++j) consider(A0[j - 1], A1[j - 1], faces[j], past_flat_coface);
   }
   const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
   const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;

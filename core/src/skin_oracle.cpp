@@ -140,54 +140,84 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
   return {S, l};
 }
 
+// What a solution on some candidates says at x: the residual r = x - Z l, the
+// value, the multiplier mu of the simplex constraint, the scale KKT gaps are
+// measured against (the size of the terms in g, so the test is relative), and
+// the worst gap on the support.
+struct Stationary {
+  Eigen::Vector3d r = Eigen::Vector3d::Zero();
+  double value = 0, mu = 0, scale = 1, violation = 0;
+};
+Stationary stationary(const Problem& p, const Solution& sol) {
+  Eigen::Vector3d y = Eigen::Vector3d::Zero();
+  double linear = 0;
+  for (size_t a = 0; a < sol.support.size(); ++a) {
+    const Ball& b = p.balls[static_cast<size_t>(sol.support[a])];
+    y += sol.lambda[a] * b.center;
+    linear += sol.lambda[a] * b.power(p.x);
+  }
+  Stationary st;
+  st.r = p.x - y;
+  st.value = (1 - p.s) * st.r.squaredNorm() + p.s * linear;
+  // KKT: g_i = mu on the support, g_k >= mu for every ball.
+  double wsum = 0;
+  for (size_t a = 0; a < sol.support.size(); ++a) {
+    st.mu += sol.lambda[a] * p.gradient_entry(sol.support[a], st.r);
+    wsum += sol.lambda[a];
+  }
+  st.mu /= wsum;
+  double reach = 1.0;
+  for (int i : sol.support) reach = std::max(reach, (p.balls[static_cast<size_t>(i)].center - p.x).norm());
+  st.scale = 1.0 + std::abs(st.mu) + 2 * (1 - p.s) * st.r.norm() * reach;
+  for (int i : sol.support)
+    st.violation = std::max(st.violation, std::abs(p.gradient_entry(i, st.r) - st.mu) / st.scale);
+  return st;
+}
+
+// Copies a solution into a result: value, gradient 2 r, and the support
+// with each candidate named by name(candidate).
+template <class Result, class Name>
+void take_solution(Result& out, const Stationary& st, const Solution& sol, Name name) {
+  out.value = st.value;
+  out.gradient = 2.0 * st.r;
+  out.support.clear();
+  for (size_t a = 0; a < sol.support.size(); ++a)
+    if (sol.lambda[a] > 0) out.support.emplace_back(name(sol.support[a]), sol.lambda[a]);
+}
+
+// The indices of the `count` smallest values.
+std::vector<int> smallest(const std::vector<double>& values, int count) {
+  std::vector<int> order(values.size());
+  std::iota(order.begin(), order.end(), 0);
+  count = std::min(count, static_cast<int>(values.size()));
+  std::nth_element(order.begin(), order.begin() + (count - 1), order.end(),
+                   [&](int a, int b) { return values[static_cast<size_t>(a)] < values[static_cast<size_t>(b)]; });
+  order.resize(static_cast<size_t>(count));
+  return order;
+}
+
+std::vector<double> powers(const std::vector<Ball>& balls, const Eigen::Vector3d& x) {
+  std::vector<double> out(balls.size());
+  for (size_t i = 0; i < balls.size(); ++i) out[i] = balls[i].power(x);
+  return out;
+}
+
 }  // namespace
 
 OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
   const Problem p{balls_, shrink_, x};
   const int n = static_cast<int>(balls_.size());
   // Candidates: the balls of smallest power distance at x.
-  std::vector<double> power(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) power[static_cast<size_t>(i)] = balls_[static_cast<size_t>(i)].power(x);
-  std::vector<int> order(static_cast<size_t>(n));
-  std::iota(order.begin(), order.end(), 0);
-  const int first = std::min(n, 24);
-  std::nth_element(order.begin(), order.begin() + (first - 1), order.end(),
-                   [&](int a, int b) { return power[static_cast<size_t>(a)] < power[static_cast<size_t>(b)]; });
-  std::vector<int> candidates(order.begin(), order.begin() + first);
-
+  std::vector<int> candidates = smallest(powers(balls_, x), 24);
   OracleResult out;
   for (int round = 0; round < 50; ++round) {
     const Solution sol = solve_on(p, candidates);
-    Eigen::Vector3d y = Eigen::Vector3d::Zero();
-    double linear = 0;
-    for (size_t a = 0; a < sol.support.size(); ++a) {
-      const Ball& b = balls_[static_cast<size_t>(sol.support[a])];
-      y += sol.lambda[a] * b.center;
-      linear += sol.lambda[a] * b.power(x);
-    }
-    const Eigen::Vector3d r = x - y;
-    out.value = (1 - shrink_) * r.squaredNorm() + shrink_ * linear;
-    out.gradient = 2.0 * r;
-    out.support.clear();
-    for (size_t a = 0; a < sol.support.size(); ++a)
-      if (sol.lambda[a] > 0) out.support.emplace_back(sol.support[a], sol.lambda[a]);
-
-    // KKT: g_i = mu on the support, g_k >= mu for every ball. Scale: the size
-    // of the terms in g, so the test is relative.
-    double mu = 0, wsum = 0;
-    for (size_t a = 0; a < sol.support.size(); ++a) {
-      mu += sol.lambda[a] * p.gradient_entry(sol.support[a], r);
-      wsum += sol.lambda[a];
-    }
-    mu /= wsum;
-    double reach = 1.0;
-    for (int i : sol.support) reach = std::max(reach, (balls_[static_cast<size_t>(i)].center - x).norm());
-    const double scale = 1.0 + std::abs(mu) + 2 * (1 - shrink_) * r.norm() * reach;
-    double violation = 0;
-    for (int i : sol.support) violation = std::max(violation, std::abs(p.gradient_entry(i, r) - mu) / scale);
+    const Stationary st = stationary(p, sol);
+    take_solution(out, st, sol, [](int ball) { return ball; });
+    double violation = st.violation;
     std::vector<int> violators;
     for (int k = 0; k < n; ++k) {
-      const double gap = (mu - p.gradient_entry(k, r)) / scale;
+      const double gap = (st.mu - p.gradient_entry(k, st.r)) / st.scale;
       if (gap > 1e-12 && std::find(candidates.begin(), candidates.end(), k) == candidates.end())
         violators.push_back(k);
       violation = std::max(violation, gap);
@@ -196,6 +226,81 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
     out.certified = violation < 1e-9;
     if (violators.empty()) break;
     candidates.insert(candidates.end(), violators.begin(), violators.end());
+  }
+  return out;
+}
+
+double MorphOracleResult::distance() const {
+  const double g = gradient.norm();
+  return g > 0 ? std::abs(value) / g : std::abs(value) > 0 ? INFINITY : 0.0;
+}
+
+MorphOracle::MorphOracle(std::vector<Ball> source, std::vector<Ball> target, double shrink)
+    : source_(std::move(source), shrink), target_(std::move(target), shrink) {}
+
+namespace {
+
+// An end of the morph is the source's (or target's) own skin function.
+MorphOracleResult end_result(const OracleResult& o, bool source_end) {
+  MorphOracleResult out;
+  out.value = o.value;
+  out.gradient = o.gradient;
+  for (const auto& [ball, weight] : o.support)
+    out.support.push_back({source_end ? BallPair{ball, -1} : BallPair{-1, ball}, weight});
+  out.kkt_violation = o.kkt_violation;
+  out.certified = o.certified;
+  return out;
+}
+
+// Gradient entries g_i = -2(1-s) <r, z_i - x> + s pi_i(x) of one side's balls.
+std::vector<double> side_gradient(const std::vector<Ball>& balls, const std::vector<double>& power,
+                                  const Eigen::Vector3d& x, const Eigen::Vector3d& r, double s) {
+  std::vector<double> g(balls.size());
+  for (size_t i = 0; i < balls.size(); ++i) g[i] = -2 * (1 - s) * r.dot(balls[i].center - x) + s * power[i];
+  return g;
+}
+
+}  // namespace
+
+MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t) const {
+  if (!(t >= 0 && t <= 1)) contract_error("MorphOracle: t must lie in [0, 1]");
+  if (t == 0) return end_result(source_.evaluate(x), true);
+  if (t == 1) return end_result(target_.evaluate(x), false);
+  const double s = source_.shrink();
+  const std::vector<Ball>& A = source_.balls();
+  const std::vector<Ball>& B = target_.balls();
+  const std::vector<double> power_a = powers(A, x), power_b = powers(B, x);
+  // Candidates: every pair of a few balls of least power on each side.
+  std::vector<BallPair> pairs;
+  for (int i : smallest(power_a, 6))
+    for (int j : smallest(power_b, 6)) pairs.push_back({i, j});
+  MorphOracleResult out;
+  for (int round = 0; round < 50; ++round) {
+    const std::vector<Ball> balls = interpolated_balls(A, B, pairs, t);
+    const Problem p{balls, s, x};
+    std::vector<int> all(pairs.size());
+    std::iota(all.begin(), all.end(), 0);
+    const Solution sol = solve_on(p, all);
+    const Stationary st = stationary(p, sol);
+    take_solution(out, st, sol, [&](int candidate) { return pairs[static_cast<size_t>(candidate)]; });
+    // Pair (i, j)'s multiplier is (1-t) g_i + t g_j, least at the least of each side.
+    const std::vector<double> ga = side_gradient(A, power_a, x, st.r, s), gb = side_gradient(B, power_b, x, st.r, s);
+    const int ia = static_cast<int>(std::min_element(ga.begin(), ga.end()) - ga.begin());
+    const int jb = static_cast<int>(std::min_element(gb.begin(), gb.end()) - gb.begin());
+    const double least = (1 - t) * ga[static_cast<size_t>(ia)] + t * gb[static_cast<size_t>(jb)];
+    out.kkt_violation = std::max(st.violation, (st.mu - least) / st.scale);
+    out.certified = out.kkt_violation < 1e-9;
+    std::vector<BallPair> violators;
+    auto add = [&](BallPair pair) {
+      const double g = (1 - t) * ga[static_cast<size_t>(pair.source)] + t * gb[static_cast<size_t>(pair.target)];
+      if ((st.mu - g) / st.scale > 1e-12 && std::find(pairs.begin(), pairs.end(), pair) == pairs.end() &&
+          std::find(violators.begin(), violators.end(), pair) == violators.end())
+        violators.push_back(pair);
+    };
+    for (int i = 0; i < static_cast<int>(A.size()); ++i) add({i, jb});
+    for (int j = 0; j < static_cast<int>(B.size()); ++j) add({ia, j});
+    if (violators.empty()) break;
+    pairs.insert(pairs.end(), violators.begin(), violators.end());
   }
   return out;
 }

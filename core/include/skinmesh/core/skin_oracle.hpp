@@ -6,6 +6,7 @@
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/interpolation.hpp"
 
 #include <Eigen/Core>
 
@@ -35,6 +36,37 @@ class SkinOracle {
  private:
   std::vector<Ball> balls_;
   double shrink_;
+};
+
+// The skin function of every frame of a morph (docs/math.md section 4):
+//     F_t(x) = min over l, u in the simplices of
+//              (1-s)|x - (1-t) Z_A l - t Z_B u|^2 + s [(1-t) l.pi_A(x) + t u.pi_B(x)],
+// which equals the skin function of all m*n interpolated balls b_ij(t). It is
+// solved over a few candidate pairs and certified against every pair: a pair's
+// optimality multiplier is (1-t) g_i + t g_j with g_i, g_j the source's and
+// target's own, so the check over all m*n pairs costs O(m + n). Like
+// SkinOracle it never builds a triangulation, and it never asks which pairs
+// are live: an independent reference for every frame of a morph.
+struct MorphOracleResult {
+  double value = 0.0;                                  // F_t(x), Angstrom^2
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();  // 2 (x - (1-t) Z_A l* - t Z_B u*)
+  // Pairs with their weight in the minimiser. At t = 0 (1) only the source's
+  // (target's) balls count, and the other index is -1.
+  std::vector<std::pair<BallPair, double>> support;
+  double kkt_violation = 0.0;  // relative, over every pair; ~1e-15 when certified
+  bool certified = false;      // kkt_violation below 1e-9
+  double distance() const;     // |F_t| / |grad F_t|, Angstrom
+};
+
+class MorphOracle {
+ public:
+  // Throws ContractError on an empty ball set or a shrink factor outside (0,1).
+  MorphOracle(std::vector<Ball> source, std::vector<Ball> target, double shrink);
+  // t in [0, 1]; throws ContractError outside.
+  MorphOracleResult evaluate(const Eigen::Vector3d& x, double t) const;
+
+ private:
+  SkinOracle source_, target_;
 };
 
 }  // namespace skinmesh

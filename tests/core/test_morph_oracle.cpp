@@ -1,0 +1,90 @@
+// The morph oracle (docs/math.md section 4): F_t over m + n unknowns, checked
+// against the skin oracle of all m*n interpolated balls (no complex, no live
+// pairs in either) and then used as the reference for the mixed complex of
+// the live pairs of B(t), as every frame of a morph will be.
+#include "test_support.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+using namespace skinmesh;
+
+namespace {
+
+// Points around the balls of both molecules, up to `spread` A off their
+// centres, and around the midpoints the interpolated balls pass through.
+std::vector<Eigen::Vector3d> points_between(const std::vector<Ball>& a, const std::vector<Ball>& b, double t,
+                                            int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<size_t> pick_a(0, a.size() - 1), pick_b(0, b.size() - 1);
+  std::uniform_real_distribution<double> u(-2.5, 2.5);
+  std::vector<Eigen::Vector3d> points;
+  for (int k = 0; k < count; ++k) {
+    const Eigen::Vector3d c = (1 - t) * a[pick_a(rng)].center + t * b[pick_b(rng)].center;
+    points.push_back(c + Eigen::Vector3d(u(rng), u(rng), u(rng)));
+  }
+  return points;
+}
+
+}  // namespace
+
+TEST_CASE("morph oracle: F_t equals the skin oracle of all m*n interpolated balls", "[oracle][morph]") {
+  const auto pept = test::centred_model(test::data_file("pept.pdb"), 1);
+  const auto al1 = test::centred_model(test::data_file("3al1.pdb"), 1);
+  const MorphOracle morph(pept, al1, 0.5);
+  for (double t : {0.2, 0.5, 0.85}) {
+    INFO("t = " << t);
+    const SkinOracle all(interpolated_balls(pept, al1, all_pairs(pept.size(), al1.size()), t), 0.5);
+    for (const Eigen::Vector3d& x : points_between(pept, al1, t, 150, 3)) {
+      const MorphOracleResult m = morph.evaluate(x, t);
+      const OracleResult o = all.evaluate(x);
+      REQUIRE(m.certified);
+      REQUIRE(o.certified);
+      CHECK(std::abs(m.value - o.value) <= 1e-9 * std::max(1.0, std::abs(o.value)));
+      CHECK((m.gradient - o.gradient).norm() <= 1e-7 * std::max(1.0, o.gradient.norm()));
+      double weight = 0;
+      for (const auto& [pair, w] : m.support) weight += w;
+      CHECK(weight == Approx(1.0).margin(1e-12));
+    }
+  }
+}
+
+TEST_CASE("morph oracle: the ends are the source's and the target's skins", "[oracle][morph]") {
+  const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
+  const auto m2 = test::centred_model(test::data_file("2k39_3models.pdb"), 2);
+  const MorphOracle morph(m1, m2, 0.5);
+  const SkinOracle source(m1, 0.5), target(m2, 0.5);
+  for (const Eigen::Vector3d& x : points_between(m1, m2, 0.5, 200, 9)) {
+    CHECK(morph.evaluate(x, 0.0).value == source.evaluate(x).value);
+    CHECK(morph.evaluate(x, 1.0).value == target.evaluate(x).value);
+    // Just inside the ends, F_t is continuous in t.
+    CHECK(std::abs(morph.evaluate(x, 1e-9).value - source.evaluate(x).value) <= 1e-5);
+  }
+  CHECK_THROWS_AS(morph.evaluate(Eigen::Vector3d::Zero(), 1.5), ContractError);
+}
+
+TEST_CASE("morph oracle: the complex of the live pairs of B(t) has the frame's skin function", "[oracle][morph]") {
+  const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
+  const auto m2 = test::centred_model(test::data_file("2k39_3models.pdb"), 2);
+  const MorphOracle morph(m1, m2, 0.5);
+  const std::vector<BallPair> live = live_pairs(m1, m2);
+  for (double t : {0.1, 0.5, 0.9}) {
+    INFO("t = " << t);
+    const SkinComplex complex = build_skin_complex(interpolated_balls(m1, m2, live, t), {0.5});
+    int hint = -1;
+    for (const Eigen::Vector3d& x : points_between(m1, m2, t, 1000, 17)) {
+      const MorphOracleResult m = morph.evaluate(x, t);
+      REQUIRE(m.certified);
+      const SkinEval e = complex.evaluate(x, hint);
+      hint = e.cell;
+      CHECK(std::abs(e.value - m.value) <= 1e-9 * std::max(1.0, std::abs(m.value)));
+      CHECK((e.value < 0) == (m.value < 0));
+    }
+  }
+}
