@@ -261,6 +261,20 @@ struct SkinComplexBuilder {
     for (int i : live) sc.grid_balls_[static_cast<size_t>(cursor[bucket_of(i)]++)] = i;
   }
 
+  static SkinComplex moved(const SkinComplex& from, std::vector<Ball> balls) {
+    if (balls.size() != from.balls_.size()) contract_error("with_balls: the number of balls differs from the complex's");
+    for (const Ball& b : balls)
+      if (!b.center.allFinite() || !std::isfinite(b.weight)) contract_error("ball with a non-finite centre or weight");
+    SkinComplex sc = from;
+    sc.balls_ = std::move(balls);
+    for (MixedCell& c : sc.cells_) {
+      c.degenerate = false;
+      compute_cell_geometry(c, sc.balls_);
+    }
+    build_start_grid(sc);
+    return sc;
+  }
+
   static SkinComplex build(std::vector<Ball> balls, const SkinComplexOptions& options) {
     check_input(balls, options);
     SkinComplex sc;
@@ -283,6 +297,17 @@ struct SkinComplexBuilder {
     return sc;
   }
 };
+
+SkinComplex SkinComplex::with_balls(std::vector<Ball> balls) const {
+  return SkinComplexBuilder::moved(*this, std::move(balls));
+}
+
+bool SkinComplex::same_flat_cells(const SkinComplex& other) const {
+  if (cells_.size() != other.cells_.size()) return false;
+  for (size_t c = 0; c < cells_.size(); ++c)
+    if (cells_[c].degenerate != other.cells_[c].degenerate) return false;
+  return true;
+}
 
 SkinComplex build_skin_complex(std::vector<Ball> balls, const SkinComplexOptions& options) {
   return SkinComplexBuilder::build(std::move(balls), options);

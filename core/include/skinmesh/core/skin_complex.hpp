@@ -102,6 +102,19 @@ class SkinComplex {
   const Coface* cofaces_begin(int c) const { return cofaces_.data() + coface_offset_[c]; }
   const Coface* cofaces_end(int c) const { return cofaces_.data() + coface_offset_[c + 1]; }
 
+  // The same complex with its balls moved: a frame of a morph (docs/math.md
+  // section 4). Cells, faces and cofaces are kept; each cell's centre, size and
+  // projector are recomputed from `balls` and the start grid is rebuilt, with
+  // no regular triangulation. Valid when the regular triangulation of `balls`
+  // has the same simplices, as B(t) of one set of live pairs has for every t in
+  // (0,1). Throws ContractError when the number of balls differs or a ball is
+  // not finite.
+  SkinComplex with_balls(std::vector<Ball> balls) const;
+  // Whether two complexes of one combinatorics have the same flat cells
+  // (MixedCell::degenerate): a frame whose flat cells differ from the complex
+  // it was moved from has left the combinatorics it was built for.
+  bool same_flat_cells(const SkinComplex& other) const;
+
   // Q_X(x) = (1-s)|(I-P)(x-z)|^2 - s|P(x-z)|^2 + s(1-s)R2, equal to (1-s) F(x) on mu_X.
   double quadric(int cell, const Eigen::Vector3d& x) const;
   // Largest violation of x in mu_X (Angstrom-scaled): <= 0 means inside.

@@ -1,0 +1,131 @@
+// Frames of a morph without a regular triangulation, and transport of skin
+// points between them (docs/math.md section 4, eq. 19), checked against the
+// morph oracle, which knows neither the complex nor the live pairs.
+#include "test_support.hpp"
+
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/transport.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+using namespace skinmesh;
+
+namespace {
+
+struct MorphPair {
+  std::string name;
+  std::vector<Ball> source, target;
+};
+
+std::vector<MorphPair> morph_pairs() {
+  return {{"2k39 model 1 -> 2", test::centred_model(test::data_file("2k39_3models.pdb"), 1),
+           test::centred_model(test::data_file("2k39_3models.pdb"), 2)},
+          {"pept -> 3al1", test::centred_model(test::data_file("pept.pdb"), 1),
+           test::centred_model(test::data_file("3al1.pdb"), 1)}};
+}
+
+// The complex of B(t), moved from the one built at t = 1/2.
+SkinComplex frame(const SkinComplex& middle, const MorphPair& m, const std::vector<BallPair>& live, double t) {
+  return middle.with_balls(interpolated_balls(m.source, m.target, live, t));
+}
+
+}  // namespace
+
+TEST_CASE("a frame's complex moved from another has the frame's skin function", "[morph]") {
+  for (const MorphPair& m : morph_pairs()) {
+    INFO(m.name);
+    const std::vector<BallPair> live = live_pairs(m.source, m.target);
+    const SkinComplex middle = build_skin_complex(interpolated_balls(m.source, m.target, live, 0.5), {0.5});
+    const MorphOracle oracle(m.source, m.target, 0.5);
+    std::mt19937 rng(4);
+    std::uniform_int_distribution<size_t> pick(0, m.source.size() - 1);
+    std::uniform_real_distribution<double> u(-2.5, 2.5);
+    for (double t : {0.05, 0.3, 0.7, 0.95}) {
+      INFO("t = " << t);
+      const SkinComplex moved = frame(middle, m, live, t);
+      CHECK(moved.same_flat_cells(middle));
+      int hint = -1;
+      for (int k = 0; k < 600; ++k) {
+        const Eigen::Vector3d x = m.source[pick(rng)].center + Eigen::Vector3d(u(rng), u(rng), u(rng));
+        const MorphOracleResult o = oracle.evaluate(x, t);
+        REQUIRE(o.certified);
+        const SkinEval e = moved.evaluate(x, hint);
+        hint = e.cell;
+        CHECK(std::abs(e.value - o.value) <= 1e-9 * std::max(1.0, std::abs(o.value)));
+      }
+    }
+  }
+}
+
+TEST_CASE("transport puts a skin point that stays in its cell on the next frame's skin", "[morph]") {
+  for (const MorphPair& m : morph_pairs()) {
+    INFO(m.name);
+    const std::vector<BallPair> live = live_pairs(m.source, m.target);
+    const SkinComplex middle = build_skin_complex(interpolated_balls(m.source, m.target, live, 0.5), {0.5});
+    const SkinComplex at = frame(middle, m, live, 0.3), next = frame(middle, m, live, 0.32);
+    const SkinMeshResult mesh = mesh_skin(at);
+    REQUIRE(mesh.status == MeshingStatus::ok);
+    const MorphOracle oracle(m.source, m.target, 0.5);
+    long stayed = 0, left = 0, vanished = 0;
+    double worst = 0, worst_before = 0;
+    for (size_t v = 0; v < mesh.mesh.vertices.size(); ++v) {
+      const Eigen::Vector3d& p = mesh.mesh.vertices[v];
+      worst_before = std::max(worst_before, oracle.evaluate(p, 0.3).distance());
+      const TransportedPoint moved = transport(at, next, mesh.mesh.cells[v], p);
+      if (moved.status == TransportStatus::left_cell) ++left;
+      if (moved.status == TransportStatus::size_vanished) ++vanished;
+      if (moved.status != TransportStatus::in_cell) continue;
+      ++stayed;
+      const MorphOracleResult o = oracle.evaluate(moved.point, 0.32);
+      REQUIRE(o.certified);
+      worst = std::max(worst, o.distance());
+    }
+    INFO(stayed << " stayed in their cell, " << left << " left it, " << vanished << " in cells whose size vanished");
+    CHECK(worst_before <= 1e-9);
+    CHECK(worst <= 1e-9);
+    CHECK(stayed > 0.5 * static_cast<double>(mesh.mesh.vertices.size()));
+  }
+}
+
+TEST_CASE("transport reports the cells where a neck forms between two frames", "[morph]") {
+  // Two equal balls whose skins are apart at the source and joined by a neck
+  // at the target: one ball moves towards the other.
+  const double w = 1.5 * 1.5 / 0.5;  // lone skin radius 1.5 A
+  const double touch = 2 * std::sqrt(w);
+  const std::vector<Ball> source{{Eigen::Vector3d(0, 0, 0), w}, {Eigen::Vector3d(1.3 * touch, 0, 0), w}};
+  const std::vector<Ball> target{{Eigen::Vector3d(0, 0, 0), w}, {Eigen::Vector3d(0.7 * touch, 0, 0), w}};
+  const MorphOracle oracle(source, target, 0.5);
+  // The skin's topology by the oracle: between the centres the body is closed
+  // (F < 0 at every point) once the neck has formed.
+  auto joined = [&](double t) {
+    const Eigen::Vector3d far = (1 - t) * source[1].center + t * target[1].center;
+    for (int k = 1; k < 200; ++k)
+      if (oracle.evaluate(far * (k / 200.0), t).value > 0) return false;
+    return true;
+  };
+  double event = -1;  // the first t on a grid of 1/100 where the skin is joined
+  for (int k = 1; k < 100 && event < 0; ++k)
+    if (joined(k / 100.0)) event = k / 100.0;
+  REQUIRE(event > 0.02);
+  REQUIRE(event < 0.98);
+
+  const std::vector<BallPair> live = live_pairs(source, target);
+  const SkinComplex middle = build_skin_complex(interpolated_balls(source, target, live, 0.5), {0.5});
+  const SkinComplex before = middle.with_balls(interpolated_balls(source, target, live, event - 0.01));
+  const SkinComplex after = middle.with_balls(interpolated_balls(source, target, live, event));
+  const SkinComplex early = middle.with_balls(interpolated_balls(source, target, live, 0.02));
+  long across = 0, quiet = 0;
+  for (int c = 0; c < static_cast<int>(middle.cells().size()); ++c) {
+    const Eigen::Vector3d p = before.cell(c).center;  // any point: only the status is asked
+    across += transport(before, after, c, p).status == TransportStatus::size_vanished;
+    quiet += transport(early, before, c, p).status == TransportStatus::size_vanished;
+  }
+  // The neck opens in one step of 1/100 and in no earlier one.
+  CHECK(across > 0);
+  CHECK(quiet == 0);
+}
