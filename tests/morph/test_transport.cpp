@@ -2,6 +2,7 @@
 // points between them (docs/math.md section 4, eq. 19), checked against the
 // morph oracle, which knows neither the complex nor the live pairs.
 #include "test_support.hpp"
+#include "two_balls.hpp"
 
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/skin_complex.hpp"
@@ -93,21 +94,11 @@ TEST_CASE("transport puts a skin point that stays in its cell on the next frame'
 }
 
 TEST_CASE("transport reports the cells where a neck forms between two frames", "[morph]") {
-  // Two equal balls whose skins are apart at the source and joined by a neck
-  // at the target: one ball moves towards the other.
-  const double w = 1.5 * 1.5 / 0.5;  // lone skin radius 1.5 A
-  const double touch = 2 * std::sqrt(w);
-  const std::vector<Ball> source{{Eigen::Vector3d(0, 0, 0), w}, {Eigen::Vector3d(1.3 * touch, 0, 0), w}};
-  const std::vector<Ball> target{{Eigen::Vector3d(0, 0, 0), w}, {Eigen::Vector3d(0.7 * touch, 0, 0), w}};
+  const test::TwoBallMorph two;
+  const std::vector<Ball>& source = two.source;
+  const std::vector<Ball>& target = two.target;
   const MorphOracle oracle(source, target, 0.5);
-  // The skin's topology by the oracle: between the centres the body is closed
-  // (F < 0 at every point) once the neck has formed.
-  auto joined = [&](double t) {
-    const Eigen::Vector3d far = (1 - t) * source[1].center + t * target[1].center;
-    for (int k = 1; k < 200; ++k)
-      if (oracle.evaluate(far * (k / 200.0), t).value > 0) return false;
-    return true;
-  };
+  auto joined = [&](double t) { return two.joined(oracle, t, 200); };
   double event = -1;  // the first t on a grid of 1/100 where the skin is joined
   for (int k = 1; k < 100 && event < 0; ++k)
     if (joined(k / 100.0)) event = k / 100.0;

@@ -1,0 +1,39 @@
+// Putting the target molecule in the source's frame before a morph: two
+// molecules in their own coordinate frames give an almost empty skin in the
+// middle (weights fall by t(1-t)|z_i - z_j|^2, docs/math.md section 1).
+#pragma once
+
+#include "skinmesh/core/molecule.hpp"
+
+#include <Eigen/Core>
+
+namespace skinmesh {
+
+enum class AlignmentMethod {
+  automatic,  // Kabsch when at least three atoms match (the same molecule), centroid otherwise
+  none,       // as read
+  centroid,   // the target's centroid onto the source's
+  kabsch,     // the rigid motion of least RMSD over matched atoms (Kabsch 1976, with the reflection excluded)
+};
+const char* alignment_method_name(AlignmentMethod method);
+
+struct RigidMotion {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // Angstrom
+  Eigen::Vector3d apply(const Eigen::Vector3d& x) const { return rotation * x + translation; }
+};
+
+struct Alignment {
+  AlignmentMethod used = AlignmentMethod::none;  // never automatic
+  RigidMotion motion;  // maps the target's coordinates into the source's frame
+  long matched = 0;    // atoms matched by chain, residue number, insertion code and atom name (Kabsch)
+  double rmsd = 0.0;   // Angstrom over the matched atoms after the motion (Kabsch)
+};
+
+// Throws ContractError for kabsch when fewer than three atoms match.
+Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod method);
+
+// The target with the motion applied to every atom.
+Molecule moved(Molecule molecule, const RigidMotion& motion);
+
+}  // namespace skinmesh

@@ -1,0 +1,41 @@
+// When the skin's topology can change during a morph: every overlay cell's
+// size R2(t) is a quadratic in t (eq. 18, docs/math.md section 4), and where
+// it changes sign inside (0,1) a neck pinches or opens, a void closes, or a
+// component appears or vanishes in that cell. Known before the first frame.
+#pragma once
+
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+
+#include <vector>
+
+namespace skinmesh {
+
+// R2(t) = a t^2 + b t + c, Angstrom^2. Exact for an overlay cell: a simplex
+// of B(t) whose dimension is (|X|-1) + (|Y|-1), X and Y the source and target
+// balls of its pairs, so that its affine hull is that of the Minkowski cell
+// (1-t) delta_X + t delta_Y and its centre z_XY(t) (eq. 17). A simplex of
+// lower dimension inside such a cell (the diagonal of a parallelogram) has a
+// mixed cell of no volume, holds no skin, and its size is not quadratic.
+struct CellSize {
+  double a = 0, b = 0, c = 0;
+  bool overlay_cell = false;
+  double at(double t) const { return (a * t + b) * t + c; }
+};
+
+// The size curve of every cell of `middle` (the complex of B(1/2) of the
+// live pairs `pairs`), from the cell's size at t = 1/4, 1/2 and 3/4 (a
+// quadratic is fixed by three values), each frame moved by with_balls.
+std::vector<CellSize> cell_sizes(const SkinComplex& middle, const std::vector<Ball>& source,
+                                 const std::vector<Ball>& target, const std::vector<BallPair>& pairs);
+
+struct TopologyEvent {
+  double t = 0;   // in (0,1)
+  int cell = -1;  // the cell of `middle` whose size changes sign
+};
+
+// Every sign change of an overlay cell's size curve inside (0,1), by time. A
+// double root (the size touches zero) counts as an event too.
+std::vector<TopologyEvent> topology_events(const std::vector<CellSize>& sizes);
+
+}  // namespace skinmesh

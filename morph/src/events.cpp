@@ -1,0 +1,67 @@
+#include "skinmesh/morph/events.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace skinmesh {
+namespace {
+
+bool is_overlay_cell(const MixedCell& cell, const std::vector<BallPair>& pairs) {
+  std::set<int> x, y;
+  for (int k = 0; k <= cell.dim; ++k) {
+    const BallPair& p = pairs[static_cast<size_t>(cell.balls[static_cast<size_t>(k)])];
+    x.insert(p.source);
+    y.insert(p.target);
+  }
+  return cell.dim == static_cast<int>(x.size() + y.size()) - 2;
+}
+
+}  // namespace
+
+std::vector<CellSize> cell_sizes(const SkinComplex& middle, const std::vector<Ball>& source,
+                                 const std::vector<Ball>& target, const std::vector<BallPair>& pairs) {
+  const SkinComplex q1 = middle.with_balls(interpolated_balls(source, target, pairs, 0.25));
+  const SkinComplex q3 = middle.with_balls(interpolated_balls(source, target, pairs, 0.75));
+  std::vector<CellSize> sizes(middle.cells().size());
+  for (size_t c = 0; c < sizes.size(); ++c) {
+    // Newton's form through (1/4, r1), (1/2, r2), (3/4, r3) with step h = 1/4.
+    const double r1 = q1.cells()[c].R2, r2 = middle.cells()[c].R2, r3 = q3.cells()[c].R2;
+    const double h = 0.25;
+    const double a = (r3 - 2 * r2 + r1) / (2 * h * h);
+    const double slope_mid = (r3 - r1) / (2 * h);  // R2'(1/2)
+    sizes[c].a = a;
+    sizes[c].b = slope_mid - a;                     // R2'(t) = 2 a t + b
+    sizes[c].c = r2 - a * 0.25 - sizes[c].b * 0.5;  // R2(1/2) = a/4 + b/2 + c
+    sizes[c].overlay_cell = is_overlay_cell(middle.cells()[c], pairs);
+  }
+  return sizes;
+}
+
+std::vector<TopologyEvent> topology_events(const std::vector<CellSize>& sizes) {
+  std::vector<TopologyEvent> events;
+  for (int c = 0; c < static_cast<int>(sizes.size()); ++c) {
+    const CellSize& q = sizes[static_cast<size_t>(c)];
+    if (!q.overlay_cell) continue;
+    const double scale = std::abs(q.a) + std::abs(q.b) + std::abs(q.c);
+    double roots[2];
+    int count = 0;
+    if (std::abs(q.a) <= 1e-14 * scale) {
+      if (q.b != 0) roots[count++] = -q.c / q.b;
+    } else {
+      const double disc = q.b * q.b - 4 * q.a * q.c;
+      if (disc >= 0) {
+        const double r = -0.5 * (q.b + std::copysign(std::sqrt(disc), q.b));
+        roots[count++] = r / q.a;
+        if (r != 0) roots[count++] = q.c / r;
+      }
+    }
+    for (int k = 0; k < count; ++k)
+      if (roots[k] > 0 && roots[k] < 1) events.push_back({roots[k], c});
+  }
+  std::sort(events.begin(), events.end(),
+            [](const TopologyEvent& x, const TopologyEvent& y) { return x.t < y.t; });
+  return events;
+}
+
+}  // namespace skinmesh
