@@ -259,3 +259,53 @@ TEST_CASE("mesh vertices carry their mixed cell and outward normal", "[mesher]")
     CHECK(r.mesh.normals[v].dot(oracle.evaluate(x).gradient.normalized()) == Approx(1.0).margin(1e-9));
   }
 }
+
+TEST_CASE("restricted_triangle judges the mesher's own triangles as the mesher did", "[mesher][criteria]") {
+  // Every triangle of a finished mesh met every criterion with its surface
+  // ball centre on its Voronoi edge, which lies on its normal line within
+  // 0.7 x tolerance of its circumcentre: looked up along that line, without
+  // the Delaunay triangulation, each must pass again.
+  for (const char* name : {"pept.pdb", "1ubi.pdb"}) {
+    INFO(name);
+    const SkinComplex complex = build_skin_complex(molecule_balls(data_file(name)), {0.5});
+    const MeshingOptions options;
+    const SkinMeshResult r = mesh_skin(complex, options);
+    REQUIRE(r.status == MeshingStatus::ok);
+    long failed = 0, missing = 0;
+    for (const auto& t : r.mesh.triangles) {
+      const std::array<Eigen::Vector3d, 3> corners{r.mesh.vertices[static_cast<size_t>(t[0])],
+                                                   r.mesh.vertices[static_cast<size_t>(t[1])],
+                                                   r.mesh.vertices[static_cast<size_t>(t[2])]};
+      const auto restricted = restricted_triangle(complex, corners, options.tolerance, r.mesh.cells[static_cast<size_t>(t[0])]);
+      if (!restricted) {
+        ++missing;
+        continue;
+      }
+      const TriangleDefect d = triangle_defect(complex, *restricted, options);
+      failed += d != TriangleDefect::none;
+    }
+    INFO(missing << " triangles without a crossing, " << failed << " failing a criterion, of "
+                 << r.mesh.triangles.size());
+    CHECK(missing == 0);
+    CHECK(failed == 0);
+  }
+  // Under stricter criteria the same triangles fail: finer sizing, a tighter
+  // distance tolerance.
+  const SkinComplex complex = build_skin_complex(molecule_balls(data_file("pept.pdb")), {0.5});
+  const SkinMeshResult r = mesh_skin(complex);
+  MeshingOptions finer, tighter;
+  finer.sizing.epsilon = 0.1;
+  tighter.tolerance = 1e-4;
+  long too_big = 0, too_far = 0;
+  for (const auto& t : r.mesh.triangles) {
+    const std::array<Eigen::Vector3d, 3> corners{r.mesh.vertices[static_cast<size_t>(t[0])],
+                                                 r.mesh.vertices[static_cast<size_t>(t[1])],
+                                                 r.mesh.vertices[static_cast<size_t>(t[2])]};
+    const auto restricted = restricted_triangle(complex, corners, 0.1, r.mesh.cells[static_cast<size_t>(t[0])]);
+    REQUIRE(restricted);
+    too_big += triangle_defect(complex, *restricted, finer) == TriangleDefect::size;
+    too_far += triangle_defect(complex, *restricted, tighter) == TriangleDefect::distance;
+  }
+  CHECK(too_big > static_cast<long>(r.mesh.triangles.size()) / 2);
+  CHECK(too_far > 0);
+}

@@ -29,6 +29,35 @@ const char* triangle_defect_name(TriangleDefect defect) {
   return "unknown";
 }
 
+std::optional<RestrictedTriangle> restricted_triangle(const SkinComplex& complex,
+                                                      const std::array<Eigen::Vector3d, 3>& corners, double reach,
+                                                      int hint) {
+  const Eigen::Vector3d& p0 = corners[0];
+  const Eigen::Vector3d u = corners[1] - p0, w = corners[2] - p0;
+  const Eigen::Vector3d uxw = u.cross(w);
+  const double cross2 = uxw.squaredNorm();
+  if (!(cross2 > 0)) return std::nullopt;
+  const Eigen::Vector3d circumcenter =
+      p0 + (u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)) / (2.0 * cross2);
+  const Eigen::Vector3d normal = uxw / std::sqrt(cross2);
+  // Corners on the skin and a triangle small against the curvature radius
+  // 1/k put the skin within r^2 k / 2 < r of the circumcentre along the
+  // normal (r the circumradius): a crossing farther than r is another piece
+  // of skin (the far side of a thin void or neck), not this triangle's.
+  const double window = std::min(reach, std::sqrt((circumcenter - p0).squaredNorm()));
+  const auto hits = complex.intersect_segment(circumcenter - window * normal, circumcenter + window * normal, hint);
+  if (hits.empty()) return std::nullopt;
+  const auto nearest = std::min_element(hits.begin(), hits.end(), [&](const SegmentCrossing& a, const SegmentCrossing& b) {
+    return (a.point - circumcenter).squaredNorm() < (b.point - circumcenter).squaredNorm();
+  });
+  RestrictedTriangle t;
+  t.corners = corners;
+  t.ball_center = nearest->point;
+  t.ball_cell = nearest->cell;
+  t.crossings = static_cast<int>(hits.size());
+  return t;
+}
+
 TriangleDefect triangle_defect(const SkinComplex& complex, const RestrictedTriangle& triangle,
                                const MeshingOptions& options) {
   if (triangle.crossings > 1) return TriangleDefect::topology;

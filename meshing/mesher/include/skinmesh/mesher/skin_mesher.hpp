@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 
 #include <functional>
 #include <string>
@@ -79,6 +80,17 @@ enum class TriangleDefect {
   shape,     // circumradius / shortest edge above 1 / (2 sin(min_angle))
 };
 const char* triangle_defect_name(TriangleDefect defect);
+
+// A triangle of a mesh kept without its Delaunay triangulation (a frame of a
+// morph) as a restricted triangle: its surface ball centre taken where the
+// triangle's normal line through its circumcentre crosses the skin, nearest
+// the circumcentre, within `reach` Angstrom of it and no farther than its
+// circumradius (crossings counts those within that window; one farther is
+// another piece of skin). Empty when the corners are collinear or no
+// crossing is in the window. hint: a cell near the triangle (a corner's).
+std::optional<RestrictedTriangle> restricted_triangle(const SkinComplex& complex,
+                                                      const std::array<Eigen::Vector3d, 3>& corners, double reach,
+                                                      int hint = -1);
 
 // The first criterion the triangle fails, in the order above, or none.
 TriangleDefect triangle_defect(const SkinComplex& complex, const RestrictedTriangle& triangle,
