@@ -34,6 +34,8 @@ std::vector<CellSize> cell_sizes(const SkinComplex& middle, const std::vector<Ba
     sizes[c].b = slope_mid - a;                     // R2'(t) = 2 a t + b
     sizes[c].c = r2 - a * 0.25 - sizes[c].b * 0.5;  // R2(1/2) = a/4 + b/2 + c
     sizes[c].overlay_cell = is_overlay_cell(middle.cells()[c], pairs);
+    sizes[c].center_half = middle.cells()[c].center;
+    sizes[c].center_slope = (q3.cells()[c].center - q1.cells()[c].center) / (2 * h);
   }
   return sizes;
 }
@@ -62,6 +64,22 @@ std::vector<TopologyEvent> topology_events(const std::vector<CellSize>& sizes) {
   std::sort(events.begin(), events.end(),
             [](const TopologyEvent& x, const TopologyEvent& y) { return x.t < y.t; });
   return events;
+}
+
+std::vector<TopologyEvent> critical_events(const std::vector<TopologyEvent>& events,
+                                           const std::vector<CellSize>& sizes, const SkinComplex& middle,
+                                           const std::vector<BallPair>& pairs, const MorphOracle& oracle) {
+  std::vector<TopologyEvent> critical;
+  for (const TopologyEvent& e : events) {
+    const MixedCell& cell = middle.cell(e.cell);
+    std::set<BallPair> own;
+    for (int k = 0; k <= cell.dim; ++k) own.insert(pairs[static_cast<size_t>(cell.balls[static_cast<size_t>(k)])]);
+    const MorphOracleResult o = oracle.evaluate(sizes[static_cast<size_t>(e.cell)].center(e.t), e.t);
+    std::set<BallPair> support;
+    for (const auto& [pair, weight] : o.support) support.insert(pair);
+    if (support == own) critical.push_back(e);
+  }
+  return critical;
 }
 
 }  // namespace skinmesh

@@ -55,6 +55,11 @@ TEST_CASE("the event where two skins join is found ahead of time", "[morph][even
   auto joined = [&](double t) { return two.joined(oracle, t, 400); };
   const double first = events.front().t;
   INFO("first event at t = " << first);
+  // It is a critical point of the skin: the cone's apex lies in its cell.
+  const std::vector<TopologyEvent> critical =
+      critical_events(events, cell_sizes(middle, two.source, two.target, live), middle, live, oracle);
+  REQUIRE_FALSE(critical.empty());
+  CHECK(critical.front().t == first);
   CHECK_FALSE(joined(first - 1e-3));
   CHECK(joined(first + 1e-3));
 }

@@ -6,6 +6,7 @@
 
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
 
 #include <vector>
 
@@ -20,7 +21,10 @@ namespace skinmesh {
 struct CellSize {
   double a = 0, b = 0, c = 0;
   bool overlay_cell = false;
+  // The cell's centre, affine in t (eq. 17): z(t) = center_half + (t - 1/2) center_slope.
+  Eigen::Vector3d center_half = Eigen::Vector3d::Zero(), center_slope = Eigen::Vector3d::Zero();
   double at(double t) const { return (a * t + b) * t + c; }
+  Eigen::Vector3d center(double t) const { return center_half + (t - 0.5) * center_slope; }
 };
 
 // The size curve of every cell of `middle` (the complex of B(1/2) of the
@@ -37,5 +41,15 @@ struct TopologyEvent {
 // Every sign change of an overlay cell's size curve inside (0,1), by time. A
 // double root (the size touches zero) counts as an event too.
 std::vector<TopologyEvent> topology_events(const std::vector<CellSize>& sizes);
+
+// The events at which the skin's topology does change: where the size of a
+// cell vanishes its quadric is a cone with apex z(t), and the skin changes
+// there only if the apex lies in the cell's own mixed cell (a critical point
+// of the skin, Edelsbrunner 1999), i.e. if the morph oracle's minimiser at
+// (z(t), t) is supported by exactly the cell's pairs. `middle` and `pairs`
+// as for cell_sizes.
+std::vector<TopologyEvent> critical_events(const std::vector<TopologyEvent>& events,
+                                           const std::vector<CellSize>& sizes, const SkinComplex& middle,
+                                           const std::vector<BallPair>& pairs, const MorphOracle& oracle);
 
 }  // namespace skinmesh

@@ -1,0 +1,89 @@
+// The morph (GMSSTF, Yan, Cheng et al.; docs/math.md section 4), set up once
+// and advanced frame by frame: the complex of B(1/2) of the live pairs is
+// built once and moved to each frame (SkinComplex::with_balls); every vertex
+// is transported inside its cell (eq. 19) or, where it left its cell,
+// projected back onto the new skin; every triangle is then judged by the
+// mesher's own criteria (restricted_triangle, triangle_defect).
+//
+// Not yet: local repair. A frame with a failing triangle, a vertex that
+// cannot be put back on the skin, or a topology event since the last frame
+// is rebuilt by the mesher from scratch, and FrameStats::full_rebuild says
+// so. Every frame is a correct mesh of the skin of B(t) either way.
+#pragma once
+
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/events.hpp"
+
+#include <vector>
+
+namespace skinmesh {
+
+struct MorphOptions {
+  double shrink = 0.5;      // s in (0,1)
+  MeshingOptions first;     // the mesh of the first frame (default: the mesher's 30 degrees)
+  // Every later frame is held to these criteria; the smaller angle bound
+  // leaves transported triangles room before they need repair.
+  MeshingOptions frames = [] {
+    MeshingOptions o;
+    o.min_angle = 20.0;     // degrees
+    return o;
+  }();
+};
+
+struct FrameStats {
+  double t = 0;
+  long vertices = 0, triangles = 0;
+  long moved = 0;              // transported inside their cell (exactly onto the new skin)
+  long relocated = 0;          // left their cell (or its size vanished) and were projected onto the new skin
+  long bad_triangles = 0;      // failing the frame's criteria after the move
+  long events = 0;             // critical topology events since the previous frame
+  bool full_rebuild = false;   // the frame was meshed from scratch
+  double seconds = 0;
+};
+
+struct MorphFrame {
+  SurfaceMesh mesh;            // cells index the frame's complex (same numbering in every frame)
+  std::vector<long> ids;       // per vertex: kept while the vertex survives, never reused
+  FrameStats stats;
+};
+
+class Morph {
+ public:
+  // Moves the mesh to frame t, later than the current one and below 1.
+  // Throws ContractError otherwise.
+  const MorphFrame& advance_to(double t);
+  const MorphFrame& frame() const { return frame_; }
+  const SkinComplex& complex() const { return current_; }
+  const std::vector<TopologyEvent>& events() const { return events_; }
+  const std::vector<BallPair>& pairs() const { return pairs_; }
+
+ private:
+  friend Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0,
+                             const MorphOptions& options);
+  Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
+        const MorphOptions& options);
+  void rebuild(const SkinComplex& next, const MeshingOptions& criteria);
+  bool move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
+  long count_bad_triangles(const SkinComplex& next, const SurfaceMesh& mesh) const;
+
+  std::vector<Ball> source_, target_;
+  std::vector<BallPair> pairs_;
+  SkinComplex middle_, current_;
+  MorphOptions options_;
+  std::vector<TopologyEvent> events_;
+  MorphFrame frame_;
+  double t_ = 0;
+  long next_id_ = 0;
+};
+
+// Live pairs, the complex of B(1/2), the topology events, and the first
+// frame at t0 in (0,1) meshed by the mesher. The balls should be aligned
+// already (alignment.hpp). Throws ContractError for t0 outside (0,1) or
+// empty ball sets; a first frame the mesher cannot make throws Error with its
+// message.
+Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0, const MorphOptions& options = {});
+
+}  // namespace skinmesh
