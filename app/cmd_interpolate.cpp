@@ -45,13 +45,13 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
   cmd->add_option("source", o->source, "source molecule (any format a molecule is read from)")->required();
   cmd->add_option("target", o->target, "target molecule")->required();
   cmd->add_option("--t,-t", o->t, "time in [0, 1]: 0 is the source, 1 the target")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(finite_number())->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--output,-o", o->output, "output weighted points file (.wpts: x y z w per line)")->required();
   cmd->add_flag("--all-pairs", o->all, "keep all m*n pairs (default: live pairs only, hidden ones dropped)");
   cmd->add_flag("--centre,--center", o->centre, "move each molecule's centroid to the origin first");
-  cmd->add_option("--source-model", o->source_model, "1-based model of the source file")->check(CLI::PositiveNumber);
-  cmd->add_option("--target-model", o->target_model, "1-based model of the target file")->check(CLI::PositiveNumber);
+  cmd->add_option("--source-model", o->source_model, "1-based model of the source file")->check(finite_number())->check(CLI::PositiveNumber);
+  cmd->add_option("--target-model", o->target_model, "1-based model of the target file")->check(finite_number())->check(CLI::PositiveNumber);
   add_molecule_settings(*cmd, o->molecule);
   cmd->callback([o, &global, &exit_code]() {
     if (!has_extension(lowercase(o->output), ".wpts"))

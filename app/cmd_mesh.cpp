@@ -59,33 +59,33 @@ void add_mesh_options(CLI::App& cmd, MeshCommandOptions& o) {
   cmd.add_option("--report", o.report, "write the quality report as JSON");
   cmd.add_option("--svg", o.svg, "write a histogram of the smallest angles as SVG");
   cmd.add_option("--min-angle", o.meshing.min_angle, "smallest angle of every triangle, degrees (at most 30)")
-      ->check(CLI::Range(1.0, 30.0))
+      ->check(finite_number())->check(CLI::Range(1.0, 30.0))
       ->capture_default_str();
   cmd.add_option("--epsilon", o.meshing.sizing.epsilon, "curvature-relative size: edge length / local radius of curvature")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd.add_option("--edge-length", o.meshing.edge_length,
                  "largest edge length in Angstrom, uniform wherever the curvature allows it (--epsilon still "
                  "bounds it where the skin bends more, which keeps the topology)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_number())->check(CLI::PositiveNumber);
   cmd.add_option("--contract-below", o.meshing.contract_below,
                  "clean-up: contract edges shorter than this times the local target length (0: off)")
-      ->check(CLI::Range(0.0, 0.99))
+      ->check(finite_number())->check(CLI::Range(0.0, 0.99))
       ->capture_default_str();
   cmd.add_option("--min-size", o.meshing.sizing.min_size, "smallest target edge length on hyperboloid patches, A")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd.add_option("--max-size", o.meshing.sizing.max_size, "largest target edge length, A")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd.add_option("--tolerance", o.meshing.tolerance,
                  "largest distance from a triangle's circumcentre to the skin along its normal, A")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd.add_option("--max-triangles", o.meshing.max_triangles, "stop with an error past this many triangles")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd.add_option("--threads", o.meshing.threads, "threads for the parallel passes (0: all)")->check(CLI::NonNegativeNumber);
+  cmd.add_option("--threads", o.meshing.threads, "threads for the parallel passes (0: all)")->check(finite_number())->check(CLI::NonNegativeNumber);
   cmd.add_flag("--float", o.single_precision, "write single-precision coordinates (smaller files)");
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
 }

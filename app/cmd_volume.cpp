@@ -42,22 +42,22 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
       ->check(CLI::IsMember({"interior", "exterior", "both"}))
       ->capture_default_str();
   cmd.add_option("--box-margin", o.volume.box_margin, "Angstrom between the skin's bounding box and the outer box")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd.add_option("--max-radius-edge", o.volume.bounds.max_radius_edge, "largest circumradius / shortest edge of a tetrahedron")
-      ->check(CLI::Range(1.0, 10.0))
+      ->check(finite_number())->check(CLI::Range(1.0, 10.0))
       ->capture_default_str();
   cmd.add_option("--min-dihedral", o.volume.bounds.min_dihedral, "smallest dihedral angle, degrees")
-      ->check(CLI::Range(0.0, 16.0))
+      ->check(finite_number())->check(CLI::Range(0.0, 16.0))
       ->capture_default_str();
   cmd.add_option("--max-volume", o.volume.max_volume, "largest tetrahedron, A^3 (0: no bound)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(finite_number())->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd.add_flag("--drop-cavities", o.drop_cavities, "fill enclosed voids instead of keeping their surfaces");
   cmd.add_option("--epsilon", o.meshing.sizing.epsilon, "surface: edge length / local radius of curvature")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd.add_option("--edge-length", o.meshing.edge_length, "surface: largest edge length, A")->check(CLI::PositiveNumber);
+  cmd.add_option("--edge-length", o.meshing.edge_length, "surface: largest edge length, A")->check(finite_number())->check(CLI::PositiveNumber);
 }
 
 VolumeOptions volume_options(const VolumeCommandOptions& o) {

@@ -4,7 +4,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
+#include <cstdlib>
 #include <memory>
+#include <string>
 
 namespace skinmesh::app {
 
@@ -12,6 +15,20 @@ struct GlobalOptions {
   bool json = false;   // machine-readable output on stdout
   bool quiet = false;  // no progress or warnings on the terminal
 };
+
+// CLI11's range checks let NaN through (every comparison with it is false)
+// and accept infinities: every numeric option is checked by this first.
+inline const CLI::Validator& finite_number() {
+  static const CLI::Validator check(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(value)) return "must be a finite number, not " + text;
+        return "";
+      },
+      "FINITE");
+  return check;
+}
 
 // Adds subcommand `name`: its options are declared on an Options struct by
 // add_options, and the callback runs `run` with them and sets `exit_code`.

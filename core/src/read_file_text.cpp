@@ -14,11 +14,23 @@
 
 namespace skinmesh::detail {
 
-std::string read_file_text(const std::string& path) {
+namespace {
+
+[[noreturn]] void too_large(const std::string& path, long long max_bytes, const char* what) {
+  input_error(path, 0, std::string(what) + " more than " + std::to_string(max_bytes) +
+                           " bytes of text, the limit for a molecule file (raise ReadOptions::max_bytes)");
+}
+
+}  // namespace
+
+std::string read_file_text(const std::string& path, long long max_bytes) {
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0)
     input_error(path, 0, std::string("cannot open file: ") + std::strerror(errno));
   if (S_ISDIR(info.st_mode)) input_error(path, 0, "is a directory, not a molecule file");
+  // A device or a pipe (/dev/zero) can be read for ever.
+  if (!S_ISREG(info.st_mode)) input_error(path, 0, "is not a regular file");
+  if (info.st_size > max_bytes) too_large(path, max_bytes, "holds");
 
   std::ifstream probe(path, std::ios::binary);
   if (!probe) input_error(path, 0, std::string("cannot open file: ") + std::strerror(errno));
@@ -33,7 +45,13 @@ std::string read_file_text(const std::string& path) {
     if (!file) input_error(path, 0, "cannot open gzip file");
     char buffer[1 << 16];
     int n = 0;
-    while ((n = gzread(file, buffer, sizeof buffer)) > 0) text.append(buffer, static_cast<size_t>(n));
+    while ((n = gzread(file, buffer, sizeof buffer)) > 0) {
+      text.append(buffer, static_cast<size_t>(n));
+      if (static_cast<long long>(text.size()) > max_bytes) {
+        gzclose(file);
+        too_large(path, max_bytes, "inflates to");
+      }
+    }
     int code = 0;
     const char* message = gzerror(file, &code);
     const bool failed = n < 0 || (code != Z_OK && code != Z_STREAM_END);

@@ -39,9 +39,9 @@ std::string where(const std::string& path, const Atom& atom) {
   return out.str();
 }
 
-std::vector<detail::RawModel> read_raw_models(const std::string& path, MoleculeFormat format,
+std::vector<detail::RawModel> read_raw_models(const std::string& path, MoleculeFormat format, long long max_bytes,
                                               std::vector<std::string>& warnings) {
-  std::string text = detail::read_file_text(path);
+  std::string text = detail::read_file_text(path, max_bytes);
   switch (format) {
     case MoleculeFormat::Pdb:
     case MoleculeFormat::Mmcif: return detail::read_pdb_or_mmcif(path, std::move(text), format, warnings);
@@ -210,7 +210,7 @@ MoleculeFormat format_from_path(const std::string& path) {
 Molecule read_molecule(const std::string& path, const ReadOptions& options) {
   const MoleculeFormat format = format_from_path(path);
   std::vector<std::string> warnings;
-  std::vector<detail::RawModel> models = read_raw_models(path, format, warnings);
+  std::vector<detail::RawModel> models = read_raw_models(path, format, options.max_bytes, warnings);
   const int count = static_cast<int>(models.size());
   if (options.model < 1 || options.model > count)
     input_error(path, 0,
@@ -222,7 +222,7 @@ Molecule read_molecule(const std::string& path, const ReadOptions& options) {
 std::vector<Molecule> read_all_models(const std::string& path, const ReadOptions& options) {
   const MoleculeFormat format = format_from_path(path);
   std::vector<std::string> warnings;
-  std::vector<detail::RawModel> models = read_raw_models(path, format, warnings);
+  std::vector<detail::RawModel> models = read_raw_models(path, format, options.max_bytes, warnings);
   std::vector<Molecule> out;
   const int count = static_cast<int>(models.size());
   for (int i = 0; i < count; ++i)

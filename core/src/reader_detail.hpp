@@ -17,8 +17,9 @@ struct RawAtom {
 using RawModel = std::vector<RawAtom>;
 
 // Whole file as text, gunzipped when it starts with the gzip magic. Throws
-// InputError when the file is missing, unreadable or empty.
-std::string read_file_text(const std::string& path);
+// InputError when the file is missing, not a regular file, unreadable, empty,
+// or more than max_bytes of text (gunzipped size included).
+std::string read_file_text(const std::string& path, long long max_bytes);
 
 // Every model in file order. Each throws InputError naming file and line.
 std::vector<RawModel> read_pdb_or_mmcif(const std::string& path, std::string text,

@@ -263,3 +263,20 @@ TEST_CASE("skinmesh interpolate writes the live pairs of B(t) as weighted points
   CHECK(refused.output.find(".wpts") != std::string::npos);
   CHECK(!std::ifstream(xyzr.path()).good());
 }
+
+TEST_CASE("numeric options refuse NaN and infinities when parsed", "[cli][bad]") {
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  skinmesh::test::TempFile out("never.ply");
+  for (const std::string& bad : {"--epsilon nan", "--tolerance inf", "--min-angle nan", "--edge-length -inf",
+                                 "--shrink nan"}) {
+    INFO(bad);
+    const Run r = run("--quiet mesh " + pept + " -o " + out.path() + " " + bad);
+    CHECK(r.code != 0);
+    CHECK(r.output.find("finite") != std::string::npos);
+  }
+  const Run t = run("interpolate " + pept + " " + pept + " --t nan -o " + out.path() + ".wpts");
+  CHECK(t.code != 0);
+  CHECK(t.output.find("finite") != std::string::npos);
+  std::ifstream none(out.path() + ".wpts");
+  CHECK_FALSE(none.good());
+}

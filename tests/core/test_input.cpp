@@ -353,3 +353,24 @@ TEST_CASE("weighted points (.wpts): weights as given, negative ones too, and bit
   test::TempFile only_comments("empty.wpts", "# nothing\n\n");
   expect_input_error(only_comments.path(), 0, "no weighted points");
 }
+
+TEST_CASE("bounded input: devices refused, size and inflated size limited", "[input][bad][bounded]") {
+  // A device is read for ever; it is refused before any byte is read.
+  expect_input_error("/dev/zero", 0, "is not a regular file");
+  // A file larger than the limit is refused by its size.
+  ReadOptions small;
+  small.max_bytes = 1000;
+  expect_input_error(test::data_file("pept.pdb"), 0, "holds more than 1000 bytes", small);
+  // A gzip of 4 MB of zeros is 4 kB: refused once it inflates past the limit,
+  // not after inflating all of it.
+  test::TempFile bomb("bomb.pdb.gz");
+  {
+    gzFile out = gzopen(bomb.path().c_str(), "wb9");
+    const std::string zeros(1 << 20, '0');
+    for (int k = 0; k < 4; ++k) gzwrite(out, zeros.data(), static_cast<unsigned>(zeros.size()));
+    gzclose(out);
+  }
+  ReadOptions mb;
+  mb.max_bytes = 1 << 20;
+  expect_input_error(bomb.path(), 0, "inflates to more than 1048576 bytes", mb);
+}

@@ -191,6 +191,27 @@ TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {
   std::remove((f_vert.path().substr(0, f_vert.path().size() - 5) + ".face").c_str());
 }
 
+TEST_CASE("PLY element counts the file cannot hold are refused at once", "[quality][io][bad][bounded]") {
+  // 10^18 records declared in a file of a hundred bytes: refused from the
+  // header, ASCII and binary alike, before any record is read.
+  for (const char* format : {"ascii", "binary_little_endian"}) {
+    INFO(format);
+    test::TempFile huge("huge.ply", std::string("ply\nformat ") + format +
+                                        " 1.0\nelement vertex 1000000000000000000\nproperty float x\nend_header\n0 0 0\n");
+    try {
+      read_surface_mesh(huge.path());
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(std::string(e.what()).find("declares 1000000000000000000 records") != std::string::npos);
+    }
+  }
+  // A small valid text PLY with no newline after its last value still reads.
+  test::TempFile tight("tight.ply",
+                       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2");
+  CHECK(read_surface_mesh(tight.path()).triangles.size() == 1);
+}
+
 TEST_CASE("bad mesh files are reported with file and line", "[quality][io][bad]") {
   test::TempFile bad_index("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
   try {

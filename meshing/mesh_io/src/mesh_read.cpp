@@ -216,6 +216,33 @@ struct PlyHeader {
   size_t body = 0;     // offset of the first byte after the header
 };
 
+size_t ply_type_size(const std::string& t, const std::string& path) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  input_error(path, 0, "unknown PLY property type '" + t + "'");
+}
+
+// Refuses element counts the body cannot hold before any is read: a record
+// takes at least the bytes of its scalar properties and list counts (binary),
+// or two characters a value (text). A header may otherwise declare 10^18
+// records in a file of a hundred bytes.
+void check_ply_counts(const PlyHeader& h, size_t body_bytes, const std::string& path) {
+  const bool ascii = h.format == "ascii";
+  double needed = 0;
+  for (const PlyElement& e : h.elements) {
+    if (e.count < 0) input_error(path, 0, "PLY element '" + e.name + "' has a negative count");
+    size_t record = 0;
+    for (const PlyProperty& p : e.properties)
+      record += ascii ? 2 : ply_type_size(p.count_type.empty() ? p.type : p.count_type, path);
+    needed += static_cast<double>(e.count) * static_cast<double>(record);
+    if (needed - (ascii ? 1 : 0) > static_cast<double>(body_bytes))  // text: no separator after the last value
+      input_error(path, 0, "PLY element '" + e.name + "' declares " + std::to_string(e.count) +
+                               " records, more than the " + std::to_string(body_bytes) + " bytes after the header hold");
+  }
+}
+
 PlyHeader read_ply_header(const std::string& data, const std::string& path) {
   const size_t end_header = data.find("end_header");
   if (data.compare(0, 3, "ply") != 0 || end_header == std::string::npos) input_error(path, 1, "not a PLY file");
@@ -240,6 +267,7 @@ PlyHeader read_ply_header(const std::string& data, const std::string& path) {
   });
   if (h.format != "ascii" && h.format != "binary_little_endian" && h.format != "binary_big_endian")
     input_error(path, 2, "unknown PLY format '" + h.format + "'");
+  check_ply_counts(h, data.size() - h.body, path);
   return h;
 }
 
@@ -256,7 +284,7 @@ class PlyValues {
       if (!(text_ >> v)) input_error(path_, 0, "PLY body ends early or holds a non-number");
       return v;
     }
-    const size_t n = size_of(type);
+    const size_t n = ply_type_size(type, path_);
     if (pos_ + n > data_.size()) input_error(path_, 0, "PLY body ends early");
     unsigned char b[8];
     std::memcpy(b, data_.data() + pos_, n);
@@ -275,14 +303,6 @@ class PlyValues {
   }
 
  private:
-  size_t size_of(const std::string& t) const {
-    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-    if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
-    if (t == "double" || t == "float64") return 8;
-    input_error(path_, 0, "unknown PLY property type '" + t + "'");
-  }
-
   const std::string& data_;
   const std::string& path_;
   bool ascii_, swap_;

@@ -41,6 +41,10 @@ struct ReadOptions {
   std::vector<std::string> chains;   // chains to keep; empty keeps every chain
   double unknown_radius = 1.80;      // Angstrom, for elements missing from the Bondi table
   bool strict_elements = false;      // true: an unknown element is an error, not a warning
+  // Bytes of text a molecule file may hold, after gunzipping: a larger file
+  // (or a small gzip that inflates past it) is refused before it fills the
+  // memory. 1 GiB holds a PDB file of about 12 million atoms.
+  long long max_bytes = 1LL << 30;
 };
 
 // What a reader kept, dropped (and why), and had to guess.
