@@ -57,9 +57,19 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
     if (!has_extension(lowercase(o->output), ".wpts"))
       contract_error(o->output + ": interpolated weights can be negative, which XYZR cannot hold; "
                                   "write weighted points, OUT.wpts");
+    check_writable({o->output});
     const auto t0 = Clock::now();
     const std::vector<Ball> a = read_balls(o->source, o->molecule.read, o->source_model, o->molecule, o->centre);
     const std::vector<Ball> b = read_balls(o->target, o->molecule.read, o->target_model, o->molecule, o->centre);
+    // All m*n pairs take 40 bytes each (the pair and its ball): refuse what
+    // would not fit rather than die in the allocation.
+    constexpr double kMaxAllPairs = 2e7;
+    const double product = static_cast<double>(a.size()) * static_cast<double>(b.size());
+    if (o->all && product > kMaxAllPairs)
+      contract_error("--all-pairs would make " + std::to_string(a.size()) + " x " + std::to_string(b.size()) +
+                     " balls (about " + std::to_string(static_cast<long long>(product * 40 / 1e6)) +
+                     " MB); at most " + std::to_string(static_cast<long long>(kMaxAllPairs)) +
+                     " are written. The live pairs (without --all-pairs) give the same skin");
     const std::vector<BallPair> pairs = o->all ? all_pairs(a.size(), b.size()) : live_pairs(a, b);
     const std::vector<Ball> balls = interpolated_balls(a, b, pairs, o->t);
     long negative = 0;

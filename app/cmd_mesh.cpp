@@ -112,6 +112,20 @@ json refinement_json(const MeshingStats& s) {
           {"contraction_attempts", s.contraction_attempts}};
 }
 
+// Every file the command will write.
+std::vector<std::string> output_paths(const MeshCommandOptions& o, MeshFormat format) {
+  std::vector<std::string> paths;
+  if (format == MeshFormat::msms) {
+    const std::string stem = o.output.substr(0, o.output.size() - 5);
+    paths = {stem + ".vert", stem + ".face"};
+  } else {
+    paths = {o.output};
+  }
+  if (!o.svg.empty()) paths.push_back(o.svg);
+  if (!o.report.empty()) paths.push_back(o.report);
+  return paths;
+}
+
 // The mesh, its attributes, the report and the histogram, all or none.
 void write_outputs(const MeshCommandOptions& o, MeshFormat format, const SkinComplex& complex,
                    const SurfaceMesh& mesh, const MeshQuality& q, json& report, Clock::time_point start) {
@@ -148,6 +162,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   const MeshFormat format = mesh_format_from_path(o.output);
+  check_writable(output_paths(o, format));
   const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
   if (progress)
     for (const std::string& w : m.warnings) std::cerr << "skinmesh: warning: " << w << "\n";

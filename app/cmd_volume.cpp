@@ -121,6 +121,10 @@ void print_volume_summary(const VolumeCommandOptions& o, const VolumeOptions& vo
 
 ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
+  std::vector<std::string> outputs_to_write;
+  for (const char* ext : {".vtu", ".msh", ".node", ".ele", ".face"}) outputs_to_write.push_back(o.output + ext);
+  if (!o.report.empty()) outputs_to_write.push_back(o.report);
+  check_writable(outputs_to_write);
   const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
   if (m.atoms.empty()) input_error(o.molecule.path, 0, "no atoms left to mesh");
   const auto balls = balls_from_molecule(m, o.molecule.shrink, o.molecule.convention());

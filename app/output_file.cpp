@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace skinmesh::app {
@@ -30,6 +31,18 @@ void OutputSet::commit() {
     if (std::rename(temporary.c_str(), target.c_str()) != 0)
       output_error(target, std::string("cannot rename into place (") + std::strerror(errno) + ")");
     staged_.erase(staged_.begin());
+  }
+}
+
+void check_writable(const std::vector<std::string>& paths) {
+  for (const std::string& path : paths) {
+    struct stat info {};
+    if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) output_error(path, "is a directory");
+    const std::string probe = path + ".tmp-" + std::to_string(::getpid());
+    std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+    if (!out) output_error(path, std::string("cannot write (") + std::strerror(errno) + ")");
+    out.close();
+    std::remove(probe.c_str());
   }
 }
 

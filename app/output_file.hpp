@@ -29,6 +29,11 @@ class OutputSet {
   std::vector<std::pair<std::string, std::string>> staged_;  // (temporary, target)
 };
 
+// Checks, before any work, that each path can be written: not a directory,
+// in a folder that exists and takes a new file. Throws OutputError naming the
+// first that cannot; leaves nothing behind.
+void check_writable(const std::vector<std::string>& paths);
+
 // One output on its own: an OutputSet of one file, committed at once.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 

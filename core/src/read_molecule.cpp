@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
@@ -52,28 +53,65 @@ std::vector<detail::RawModel> read_raw_models(const std::string& path, MoleculeF
   return {};
 }
 
-// One conformer per atom: among the alternate locations of one atom (same chain,
-// residue number, insertion code and name) keep the highest occupancy; ties go
-// to the first in the file.
-std::vector<detail::RawAtom> pick_conformers(std::vector<detail::RawAtom> atoms, long& dropped) {
-  using Key = std::tuple<std::string, int, char, std::string>;
-  std::map<Key, size_t> best;
+// One conformer per residue (chain, residue number, insertion code): the
+// alternate-location label with the highest mean occupancy over the
+// residue's atoms that carry it (ties to the label met first), plus the
+// residue's unlabelled atoms of that label's residue name. Choosing per atom
+// would join conformers into a chimera; where one position holds two
+// residue types (microheterogeneity, e.g. Pro or Ser) only one type is kept,
+// and a warning names the residue.
+std::vector<detail::RawAtom> pick_conformers(std::vector<detail::RawAtom> atoms, const std::string& path,
+                                             long& dropped, std::vector<std::string>& warnings) {
+  using Residue = std::tuple<std::string, int, char>;
+  struct Label {
+    double occupancy = 0;
+    long count = 0;
+    size_t first = 0;
+    std::set<std::string> names;  // residue names carrying this label
+  };
+  std::map<Residue, std::map<char, Label>> labels;
+  std::map<Residue, std::set<std::string>> names;
   for (size_t i = 0; i < atoms.size(); ++i) {
     const Atom& a = atoms[i].atom;
+    const Residue r{a.chain, a.residue_number, a.insertion_code};
+    names[r].insert(a.residue);
     if (a.altloc == ' ') continue;
-    const Key key{a.chain, a.residue_number, a.insertion_code, a.name};
-    auto [it, inserted] = best.emplace(key, i);
-    if (!inserted && a.occupancy > atoms[it->second].atom.occupancy) it->second = i;
+    auto [it, fresh] = labels[r].try_emplace(a.altloc);
+    if (fresh) it->second.first = i;
+    it->second.occupancy += a.occupancy;
+    ++it->second.count;
+    it->second.names.insert(a.residue);
+  }
+  std::map<Residue, std::pair<char, std::set<std::string>>> chosen;  // label and its residue names
+  for (const auto& [r, by_label] : labels) {
+    const std::pair<const char, Label>* best = nullptr;
+    for (const auto& entry : by_label) {
+      const double mean = entry.second.occupancy / static_cast<double>(entry.second.count);
+      if (!best) { best = &entry; continue; }
+      const double best_mean = best->second.occupancy / static_cast<double>(best->second.count);
+      if (mean > best_mean || (mean == best_mean && entry.second.first < best->second.first)) best = &entry;
+    }
+    chosen[r] = {best->first, best->second.names};
+    if (names[r].size() > 1) {
+      std::string kinds;
+      for (const std::string& n : names[r]) kinds += (kinds.empty() ? "" : " or ") + n;
+      warnings.push_back(path + ": chain " + std::get<0>(r) + " residue " + std::to_string(std::get<1>(r)) +
+                         " is microheterogeneous (" + kinds + "); kept " + *best->second.names.begin() +
+                         " (alternate location " + std::string(1, best->first) + ")");
+    }
   }
   std::vector<detail::RawAtom> kept;
   kept.reserve(atoms.size());
-  for (size_t i = 0; i < atoms.size(); ++i) {
-    const Atom& a = atoms[i].atom;
-    if (a.altloc != ' ' && best.at(Key{a.chain, a.residue_number, a.insertion_code, a.name}) != i) {
+  for (detail::RawAtom& raw : atoms) {
+    const Atom& a = raw.atom;
+    const auto it = chosen.find(Residue{a.chain, a.residue_number, a.insertion_code});
+    const bool keep = it == chosen.end() ||
+                      (a.altloc == ' ' ? it->second.second.count(a.residue) > 0 : a.altloc == it->second.first);
+    if (!keep) {
       ++dropped;
       continue;
     }
-    kept.push_back(std::move(atoms[i]));
+    kept.push_back(std::move(raw));
   }
   return kept;
 }
@@ -100,7 +138,7 @@ std::vector<detail::RawAtom> select_atoms(detail::RawModel raw, const ReadOption
     atoms.push_back(std::move(r));
   }
   long altloc_dropped = 0;
-  atoms = pick_conformers(std::move(atoms), altloc_dropped);
+  atoms = pick_conformers(std::move(atoms), m.source, altloc_dropped, m.warnings);
   if (altloc_dropped) m.skipped["alternate location"] += altloc_dropped;
   return atoms;
 }

@@ -280,3 +280,38 @@ TEST_CASE("numeric options refuse NaN and infinities when parsed", "[cli][bad]")
   std::ifstream none(out.path() + ".wpts");
   CHECK_FALSE(none.good());
 }
+
+TEST_CASE("outputs that cannot be written are refused before the work", "[cli][bad]") {
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  skinmesh::test::TempFile dir_holder("x");
+  const std::string folder = dir_holder.path().substr(0, dir_holder.path().rfind('/'));
+  // The report is a directory: refused before meshing, and no mesh is left.
+  skinmesh::test::TempFile mesh("m.ply");
+  std::remove(mesh.path().c_str());
+  const Run r = run("--quiet mesh " + pept + " -o " + mesh.path() + " --report " + folder);
+  CHECK(r.code != 0);
+  CHECK(r.output.find("is a directory") != std::string::npos);
+  CHECK_FALSE(std::ifstream(mesh.path()).good());
+  // A folder that does not exist, for the mesh and for a volume stem.
+  const Run nowhere = run("--quiet mesh " + pept + " -o /nonexistent-skinmesh/m.ply");
+  CHECK(nowhere.code != 0);
+  CHECK(nowhere.output.find("/nonexistent-skinmesh/m.ply") != std::string::npos);
+  const Run volume = run("--quiet volume " + pept + " -o /nonexistent-skinmesh/v");
+  CHECK(volume.code != 0);
+  CHECK(volume.output.find("cannot write") != std::string::npos);
+}
+
+TEST_CASE("interpolate --all-pairs refuses a set that would not fit, at once", "[cli][bad]") {
+  // 4,500 x 4,500 atoms: 20.25 million pairs, over the 20 million written.
+  std::string atoms;
+  for (int i = 0; i < 4500; ++i)
+    atoms += std::to_string(3.0 * (i % 30)) + " " + std::to_string(3.0 * ((i / 30) % 30)) + " " +
+             std::to_string(3.0 * (i / 900)) + " 1.5\n";
+  skinmesh::test::TempFile big("big.xyzr", atoms);
+  skinmesh::test::TempFile out("all.wpts");
+  std::remove(out.path().c_str());
+  const Run r = run("interpolate " + big.path() + " " + big.path() + " --all-pairs --t 0.5 -o " + out.path());
+  CHECK(r.code == 2);
+  CHECK(r.output.find("4500 x 4500") != std::string::npos);
+  CHECK_FALSE(std::ifstream(out.path()).good());
+}

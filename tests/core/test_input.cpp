@@ -94,27 +94,48 @@ TEST_CASE("hydrogens kept on request (1ejg)", "[input]") {
   CHECK(without.skipped.at("hydrogen") > 0);
 }
 
-TEST_CASE("alternate locations: highest occupancy, ties to the first", "[input]") {
+TEST_CASE("alternate locations: one conformer per residue, highest occupancy, ties to the first", "[input]") {
   std::string pdb;
+  // Residue 1: label B has the higher mean occupancy (0.60 against 0.40), so
+  // both CA and CB come from B, never a mixture of the two conformers.
   pdb += pdb_atom(1, " N", "SER", 'A', 1, 0, 0, 0, "N");
   pdb += pdb_atom(2, " CA", "SER", 'A', 1, 1.5, 0, 0, "C", 'A', 0.30);
   pdb += pdb_atom(3, " CA", "SER", 'A', 1, 1.6, 0, 0, "C", 'B', 0.70);
   pdb += pdb_atom(4, " CB", "SER", 'A', 1, 2.0, 1, 0, "C", 'A', 0.50);
   pdb += pdb_atom(5, " CB", "SER", 'A', 1, 2.1, 1, 0, "C", 'B', 0.50);
+  // Residue 2: a tie goes to the label met first.
+  pdb += pdb_atom(6, " CA", "GLY", 'A', 2, 5.0, 0, 0, "C", 'B', 0.50);
+  pdb += pdb_atom(7, " CA", "GLY", 'A', 2, 5.1, 0, 0, "C", 'A', 0.50);
   TempFile f("alt.pdb", pdb + "END\n");
   const Molecule m = read_molecule(f.path());
-  REQUIRE(m.atoms.size() == 3);
-  CHECK(m.skipped.at("alternate location") == 2);
+  REQUIRE(m.atoms.size() == 4);
+  CHECK(m.skipped.at("alternate location") == 3);
   for (const Atom& a : m.atoms) {
-    if (a.name == "CA") CHECK(a.altloc == 'B');  // 0.70 beats 0.30
-    if (a.name == "CB") CHECK(a.altloc == 'A');  // tie: the first
+    if (a.residue_number == 1 && a.name != "N") CHECK(a.altloc == 'B');
+    if (a.residue_number == 2) CHECK(a.altloc == 'B');
   }
-  // A real entry: 1ejg keeps one conformer per atom.
+}
+
+TEST_CASE("alternate locations of a real entry: 1ejg's microheterogeneous residues", "[input]") {
+  // Residue 22 of crambin is Pro (A) or Ser (B, C), residue 25 Leu (A) or Ile
+  // (B, C): one residue type each, never a proline carrying serine's OG.
   const Molecule crambin = read_molecule(test::data_file("1ejg.pdb"));
+  CHECK(crambin.atoms.size() == 327);
   std::set<std::tuple<std::string, int, std::string>> ids;
-  for (const Atom& a : crambin.atoms) ids.insert({a.chain, a.residue_number, a.name});
+  std::set<std::string> at22, at25;
+  for (const Atom& a : crambin.atoms) {
+    ids.insert({a.chain, a.residue_number, a.name});
+    if (a.residue_number == 22) at22.insert(a.residue);
+    if (a.residue_number == 25) at25.insert(a.residue);
+  }
   CHECK(ids.size() == crambin.atoms.size());
-  CHECK(crambin.skipped.at("alternate location") > 0);
+  CHECK(at22 == std::set<std::string>{"PRO"});
+  CHECK(at25 == std::set<std::string>{"LEU"});
+  long named = 0;
+  for (const std::string& w : crambin.warnings)
+    named += w.find("residue 22 is microheterogeneous") != std::string::npos ||
+             w.find("residue 25 is microheterogeneous") != std::string::npos;
+  CHECK(named == 2);
 }
 
 TEST_CASE("models: first by default, --model N, or all of them", "[input]") {
