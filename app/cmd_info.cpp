@@ -2,6 +2,7 @@
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "molecule_options.hpp"
+#include "quality_report.hpp"
 
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/core/radii.hpp"
@@ -102,7 +103,7 @@ void print_text(const json& j, std::ostream& out) {
     if (r.contains("radius")) out << "=" << r["radius"].get<double>();
   }
   out << (j["radii"].front()["source"] == "file" ? "  (from the file)" : "  (Angstrom, Bondi 1964)") << "\n";
-  if (!j["unknown_elements"].empty()) out << "  unknown elements: " << j["unknown_elements"].dump() << "\n";
+  if (!j["unknown_elements"].empty()) out << "  unknown elements: " << j["unknown_elements"].dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   const auto& lo = j["bounding_box"]["min"];
   const auto& hi = j["bounding_box"]["max"];
   out << std::fixed << std::setprecision(3) << "  bounding box:   [" << lo[0].get<double>() << ", "
@@ -152,7 +153,7 @@ void add_info_command(CLI::App& app, const GlobalOptions& global, int& exit_code
       all.push_back(describe(m, *options));
     }
     if (global.json) {
-      std::cout << (options->all_models ? all : all.front()).dump(2) << "\n";
+      std::cout << json_text((options->all_models ? all : all.front())) << "\n";
     } else {
       for (const json& j : all) print_text(j, std::cout);
     }

@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "molecule_options.hpp"
+#include "quality_report.hpp"
 #include "output_file.hpp"
 
 #include "skinmesh/core/stopwatch.hpp"
@@ -86,7 +87,7 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
                           {"source_balls", a.size()}, {"target_balls", b.size()}, {"all_pairs", a.size() * b.size()},
                           {"balls", balls.size()}, {"negative_weights", negative}, {"live_pairs_only", !o->all},
                           {"output", o->output},   {"seconds", seconds}};
-    if (global.json) std::cout << report.dump(2) << "\n";
+    if (global.json) std::cout << json_text(report) << "\n";
     else if (!global.quiet)
       std::cout << o->output << ": " << balls.size() << " weighted points at t = " << o->t << " ("
                 << (o->all ? "all" : "live") << " pairs of " << a.size() << " x " << b.size() << " = "

@@ -142,7 +142,7 @@ void write_outputs(const MeshCommandOptions& o, MeshFormat format, const SkinCom
   }
   if (!o.svg.empty()) outputs.add(o.svg, [&](std::ostream& out) { write_svg(out, q, o.output); });
   report["seconds"]["total"] = seconds_since(start);
-  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << json_text(report) << "\n"; });
   outputs.commit();
 }
 
@@ -179,6 +179,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
     };
   const SkinMeshResult result = mesh_skin(complex, meshing);
   if (progress) std::cerr << "\r" << std::string(60, ' ') << "\r";
+  if (result.status == MeshingStatus::empty_skin) input_error(o.molecule.path, 0, result.message);
   if (result.status != MeshingStatus::ok) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": " << result.message << "\n";
     if (result.status == MeshingStatus::over_budget)
@@ -216,11 +217,11 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
                    {"grading", seconds_grading}}}};
   if (!g.all_hold()) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": the mesh fails a guarantee (see below); nothing written\n"
-              << report["guarantees"].dump(2) << "\n";
+              << json_text(report["guarantees"]) << "\n";
     return ExitCode::not_met;
   }
   write_outputs(o, format, complex, result.mesh, g.quality, report, start);
-  if (global.json) std::cout << report.dump(2) << "\n";
+  if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet) print_summary(o, g, report);
   return ExitCode::ok;
 }

@@ -48,7 +48,7 @@ void grade_tets(const std::string& file, const TetMesh& tets, const GlobalOption
   json report = tet_report(tets, q);
   report["file"] = file;
   if (global.json) {
-    std::cout << report.dump(2) << "\n";
+    std::cout << json_text(report) << "\n";
     return;
   }
   std::cout << file << ": " << q.points << " points, " << q.tets << " tetrahedra, volume " << q.volume << " A^3\n";
@@ -82,7 +82,7 @@ void grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, cons
   }
   if (!o.svg.empty()) write_file_atomically(o.svg, [&](std::ostream& out) { write_svg(out, q, o.mesh); });
   if (global.json) {
-    std::cout << report.dump(2) << "\n";
+    std::cout << json_text(report) << "\n";
     return;
   }
   print_quality_summary(std::cout, o.mesh, q);

@@ -131,6 +131,7 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   const SkinComplex complex = build_skin_complex(balls, {o.molecule.shrink});
   if (progress) std::cerr << "skinmesh: meshing the skin\n";
   const SkinMeshResult surface = mesh_skin(complex, o.meshing);
+  if (surface.status == MeshingStatus::empty_skin) input_error(o.molecule.path, 0, surface.message);
   if (surface.status != MeshingStatus::ok) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": " << surface.message << "\n";
     return ExitCode::not_met;
@@ -140,7 +141,7 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   const GuaranteeReport g = check_guarantees(surface.mesh, balls, o.molecule.shrink, bounds);
   if (!g.all_hold()) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": the skin mesh fails a guarantee; no volume mesh\n"
-              << guarantees_json(g).dump(2) << "\n";
+              << json_text(guarantees_json(g)) << "\n";
     return ExitCode::not_met;
   }
   const VolumeOptions volume = volume_options(o);
@@ -159,9 +160,9 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   outputs.add(o.output + ".node", [&](std::ostream& out) { write_tetgen_node(out, made.mesh); });
   outputs.add(o.output + ".ele", [&](std::ostream& out) { write_tetgen_ele(out, made.mesh); });
   outputs.add(o.output + ".face", [&](std::ostream& out) { write_tetgen_face(out, made.mesh); });
-  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << json_text(report) << "\n"; });
   outputs.commit();
-  if (global.json) std::cout << report.dump(2) << "\n";
+  if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet) print_volume_summary(o, volume, q, report);
   return ExitCode::ok;
 }

@@ -9,6 +9,10 @@
 
 namespace skinmesh::app {
 
+std::string json_text(const nlohmann::json& j) {
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 nlohmann::json to_json(const MeshQuality& q) {
   using json = nlohmann::json;
   json valence = json::object();

@@ -17,6 +17,11 @@
 
 namespace skinmesh::app {
 
+// JSON as text, two-space indented. Bytes that are not UTF-8 (an atom name
+// or a file name from an old file) become U+FFFD instead of an exception
+// after the work is done.
+std::string json_text(const nlohmann::json& j);
+
 nlohmann::json to_json(const MeshQuality& q);
 
 // {"max", "mean", "uncertified"}.

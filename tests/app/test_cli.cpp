@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <cstdio>
 #include <sys/wait.h>
 
@@ -314,4 +315,28 @@ TEST_CASE("interpolate --all-pairs refuses a set that would not fit, at once", "
   CHECK(r.code == 2);
   CHECK(r.output.find("4500 x 4500") != std::string::npos);
   CHECK_FALSE(std::ifstream(out.path()).good());
+}
+
+TEST_CASE("an empty skin is said to be empty; non-UTF-8 names do not break --json", "[cli][bad]") {
+  // Every weight negative: no surface. The error says so and names the file.
+  skinmesh::test::TempFile negative("negative.wpts", "0 0 0 -1\n3 0 0 -2\n");
+  skinmesh::test::TempFile out("empty.ply");
+  std::remove(out.path().c_str());
+  const Run empty = run("--quiet mesh " + negative.path() + " -o " + out.path());
+  CHECK(empty.code == 2);
+  CHECK(empty.output.find(negative.path()) != std::string::npos);
+  CHECK(empty.output.find("skin of this ball set is empty") != std::string::npos);
+  CHECK_FALSE(std::ifstream(out.path()).good());
+  // A molecule file whose name is not UTF-8: the JSON report replaces the
+  // bytes instead of failing after the mesh is written.
+  std::ifstream pept(skinmesh::test::data_file("pept.pdb"));
+  std::stringstream text;
+  text << pept.rdbuf();
+  skinmesh::test::TempFile odd("pept-\xff\xfe.pdb", text.str());
+  const Run r = run("--json mesh " + odd.path() + " -o " + out.path());
+  CHECK(r.code == 0);
+  const size_t start = r.output.find('{');
+  REQUIRE(start != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(r.output.substr(start));
+  CHECK(j["molecule"].get<std::string>().find("\xef\xbf\xbd") != std::string::npos);  // U+FFFD
 }

@@ -228,6 +228,20 @@ TEST_CASE("bad mesh files are reported with file and line", "[quality][io][bad]"
   CHECK_THROWS_AS(read_surface_mesh("/nonexistent.off"), InputError);
   test::TempFile unknown("m.xyz", "1 2 3");
   CHECK_THROWS_AS(read_surface_mesh(unknown.path()), InputError);
+  // Counts and indices that no double-to-integer cast may see: refused with
+  // the file and line, not reported as negative numbers.
+  for (const char* text : {"OFF\n1e19 1 0\n", "OFF\ninf 1 0\n", "OFF\nnan 1 0\n", "OFF\n3 1000000 0\n0 0 0\n",
+                           "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1e300\n"}) {
+    INFO(text);
+    test::TempFile off("count.off", text);
+    try {
+      read_surface_mesh(off.path());
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.line() > 0);
+      CHECK(std::string(e.what()).find(off.path()) != std::string::npos);
+    }
+  }
 }
 
 TEST_CASE("CGAL's skin mesh of pept: closed, manifold, oriented, no self-intersections", "[quality][cgal]") {

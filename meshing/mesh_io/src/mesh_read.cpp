@@ -60,10 +60,23 @@ struct Tokens {
     if (end != w.c_str() + w.size()) input_error(*path, at, "expected a number, found '" + w + "'");
     return v;
   }
+  // A whole number a mesh can index: finite and below 2^53 in magnitude, so
+  // that no cast from double is undefined or loses the value.
   long integer() {
+    const long at = line();
     const double v = number();
-    if (v != std::floor(v)) input_error(*path, line(), "expected an integer");
+    if (!std::isfinite(v) || v != std::floor(v) || std::abs(v) > 9007199254740992.0)
+      input_error(*path, at, "expected an integer of at most 2^53, found " + words[next - 1]);
     return static_cast<long>(v);
+  }
+  // A count of items that follow: at most the words left in the file.
+  long count() {
+    const long at = line();
+    const long n = integer();
+    if (n < 0) input_error(*path, at, "negative element count");
+    if (static_cast<size_t>(n) > words.size() - next)
+      input_error(*path, at, "a count of " + std::to_string(n) + " is more than the file holds");
+    return n;
   }
 };
 
@@ -104,9 +117,8 @@ SurfaceMesh read_off(const std::string& path) {
   Tokens t = tokenize(text, path);
   std::string head = t.word();
   if (head != "OFF" && head != "COFF" && head != "NOFF") input_error(path, 1, "not an OFF file (header '" + head + "')");
-  const long nv = t.integer(), nf = t.integer();
+  const long nv = t.count(), nf = t.count();
   t.integer();  // edges
-  if (nv < 0 || nf < 0) input_error(path, t.line(), "negative element count");
   SurfaceMesh mesh;
   for (long i = 0; i < nv; ++i) {
     const long at = t.line();
@@ -117,7 +129,7 @@ SurfaceMesh read_off(const std::string& path) {
   }
   for (long f = 0; f < nf; ++f) {
     const long at = t.line();
-    const long n = t.integer();
+    const long n = t.count();
     std::vector<long> corners;
     for (long k = 0; k < n; ++k) corners.push_back(t.integer());
     add_polygon(mesh, corners, path, at);

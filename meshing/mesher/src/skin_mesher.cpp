@@ -530,6 +530,7 @@ const char* meshing_status_name(MeshingStatus status) {
     case MeshingStatus::over_budget: return "over_budget";
     case MeshingStatus::stalled: return "stalled";
     case MeshingStatus::unrepairable: return "unrepairable";
+    case MeshingStatus::empty_skin: return "empty_skin";
   }
   return "unknown";
 }
@@ -549,6 +550,14 @@ SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& optio
   std::optional<tbb::global_control> threads;
   if (options.threads > 0)
     threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
+  // With every weight <= 0 every power distance is >= 0, so F >= 0 (docs/math.md
+  // section 2): the body is empty and so is the skin.
+  if (std::none_of(complex.balls().begin(), complex.balls().end(), [](const Ball& b) { return b.weight > 0; })) {
+    SkinMeshResult empty;
+    empty.status = MeshingStatus::empty_skin;
+    empty.message = "the skin of this ball set is empty: no ball has a positive weight";
+    return empty;
+  }
   detail::Refiner refiner(complex, options);
   try {
     return refiner.run();

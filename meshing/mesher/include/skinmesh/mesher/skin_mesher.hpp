@@ -116,6 +116,7 @@ enum class MeshingStatus {
   over_budget,   // the mesh would pass MeshingOptions::max_triangles
   stalled,       // bad triangles left whose surface Delaunay ball centres are samples already (rounding)
   unrepairable,  // a sample with no restricted triangle and no point to repair it with
+  empty_skin,    // no ball has a positive weight: F >= 0 everywhere, there is no surface to mesh
 };
 const char* meshing_status_name(MeshingStatus status);
 
