@@ -32,6 +32,24 @@ bool plausible_element_and_charge(const std::string& line) {
   return digit_sign || sign_digit;
 }
 
+// A PDB coordinate is a plain decimal (format F8.3): strtod also takes hex
+// floats and exponents ("0x1p3", "1e2"), which gemmi reads otherwise (as 0).
+bool plain_decimal(const std::string& field) {
+  const size_t first = field.find_first_not_of(' ');
+  if (first == std::string::npos) return false;
+  const size_t last = field.find_last_not_of(" \r");
+  size_t i = first;
+  if (field[i] == '+' || field[i] == '-') ++i;
+  bool digits = false, point = false;
+  for (; i <= last; ++i) {
+    const char c = field[i];
+    if (std::isdigit(static_cast<unsigned char>(c))) digits = true;
+    else if (c == '.' && !point) point = true;
+    else return false;
+  }
+  return digits;
+}
+
 struct PdbPrepass {
   std::string text;                              // sanitised copy handed to gemmi
   std::map<std::pair<int, int>, long> line_of;   // (model ordinal, serial) -> line
@@ -65,7 +83,7 @@ PdbPrepass prepass_pdb(const std::string& path, const std::string& text) {
       for (int k = 0; k < 3; ++k) {
         const std::string field = body.substr(30 + 8 * k, 8);
         double value = 0;
-        if (!parse_finite_double(field, value))
+        if (!plain_decimal(field) || !parse_finite_double(field, value))
           input_error(path, line_number,
                       std::string("malformed or non-finite ") + axes[k] + " coordinate '" + field +
                           "' (columns " + std::to_string(31 + 8 * k) + "-" + std::to_string(38 + 8 * k) + ")");

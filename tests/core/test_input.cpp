@@ -274,6 +274,14 @@ TEST_CASE("bad input: malformed, NaN and infinite coordinates name the line", "[
   TempFile nan("nan.pdb", good + nan_line);
   expect_input_error(nan.path(), 2, "non-finite z coordinate");
 
+  // A hex float or an exponent is no PDB coordinate (gemmi would read 0.000).
+  for (const char* odd : {"   0x1p3", "   1.0e2"}) {
+    std::string odd_line = pdb_atom(2, " CA", "GLY", 'A', 1, 1.5, 0, 0, "C");
+    odd_line.replace(30, 8, odd);
+    TempFile hex("odd.pdb", good + odd_line);
+    expect_input_error(hex.path(), 2, "x coordinate");
+  }
+
   struct BadFile {
     const char* name;
     std::string contents;
@@ -300,8 +308,12 @@ TEST_CASE("bad input: an enormous coordinate", "[input][bad]") {
   TempFile huge("huge.xyzr", "0 0 0 1.5\n1e30 0 0 1.5\n");
   expect_input_error(huge.path(), 2, "beyond");
   TempFile big_pdb("big.pdb", pdb_atom(1, " N", "GLY", 'A', 1, 0, 0, 0, "N") +
-                                  pdb_atom(2, " C", "GLY", 'A', 1, 0, 0, 0, "C").replace(30, 8, "9.99e+99"));
+                                  pdb_atom(2, " C", "GLY", 'A', 1, 0, 0, 0, "C").replace(30, 8, "99999999"));
   expect_input_error(big_pdb.path(), 2, "beyond");
+  // An exponent does not fit a PDB coordinate column (F8.3) at all.
+  TempFile exp_pdb("exp.pdb", pdb_atom(1, " N", "GLY", 'A', 1, 0, 0, 0, "N") +
+                                  pdb_atom(2, " C", "GLY", 'A', 1, 0, 0, 0, "C").replace(30, 8, "9.99e+99"));
+  expect_input_error(exp_pdb.path(), 2, "malformed or non-finite x coordinate");
 }
 
 TEST_CASE("unknown elements: fallback radius with a report, or an error when strict", "[input][bad]") {
