@@ -23,9 +23,8 @@
 #include <Eigen/Core>
 
 #include <array>
-#include <optional>
-
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace skinmesh {
