@@ -191,6 +191,20 @@ TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {
   std::remove((f_vert.path().substr(0, f_vert.path().size() - 5) + ".face").c_str());
 }
 
+TEST_CASE("OFF in free format (records running on across lines) reads", "[quality][io]") {
+  test::TempFile one_line("free.off", "OFF 4 4 6 0 0 0 1 0 0 0 1 0 0 0 1 3 0 2 1 3 0 1 3 3 0 3 2 3 1 2 3\n");
+  const SurfaceMesh m = read_surface_mesh(one_line.path());
+  CHECK(m.vertices.size() == 4);
+  CHECK(m.triangles.size() == 4);
+  test::TempFile wrapped("wrapped.off", "OFF\n3 1 0\n0 0 0 1 0\n0 0 1 0\n3 0 1\n2\n");
+  const SurfaceMesh w = read_surface_mesh(wrapped.path());
+  CHECK(w.vertices.size() == 3);
+  CHECK(w.triangles.size() == 1);
+  // A record a line still skips COFF's colours.
+  test::TempFile coff("c.off", "COFF\n3 1 0\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1\n0 1 0 1 1 1 1\n3 0 1 2\n");
+  CHECK(read_surface_mesh(coff.path()).triangles.size() == 1);
+}
+
 TEST_CASE("PLY element counts the file cannot hold are refused at once", "[quality][io][bad][bounded]") {
   // 10^18 records declared in a file of a hundred bytes: refused from the
   // header, ASCII and binary alike, before any record is read.

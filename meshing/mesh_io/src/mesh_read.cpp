@@ -117,15 +117,24 @@ SurfaceMesh read_off(const std::string& path) {
   Tokens t = tokenize(text, path);
   std::string head = t.word();
   if (head != "OFF" && head != "COFF" && head != "NOFF") input_error(path, 1, "not an OFF file (header '" + head + "')");
+  const long counts_line = t.line();
   const long nv = t.count(), nf = t.count();
   t.integer();  // edges
+  // A record a line, where COFF/NOFF vertices and coloured faces carry more
+  // numbers to skip; or plain OFF in free format (records run on across
+  // lines, the counts' line included), where nothing is skipped.
+  const bool free_format =
+      head == "OFF" && !t.done() &&
+      (t.line() == counts_line || (t.next + 3 < t.words.size() && t.lines[t.next + 3] == t.lines[t.next]));
+  auto skip_rest_of_line = [&](long at) {
+    while (!free_format && !t.done() && t.lines[t.next] == at) t.word();
+  };
   SurfaceMesh mesh;
   for (long i = 0; i < nv; ++i) {
     const long at = t.line();
     const double x = t.number(), y = t.number(), z = t.number();
     mesh.vertices.push_back(checked_point(x, y, z, path, at));
-    // COFF/NOFF carry more numbers on the line.
-    while (!t.done() && t.lines[t.next] == at) t.word();
+    skip_rest_of_line(at);
   }
   for (long f = 0; f < nf; ++f) {
     const long at = t.line();
@@ -133,7 +142,7 @@ SurfaceMesh read_off(const std::string& path) {
     std::vector<long> corners;
     for (long k = 0; k < n; ++k) corners.push_back(t.integer());
     add_polygon(mesh, corners, path, at);
-    while (!t.done() && t.lines[t.next] == at) t.word();  // face colours
+    skip_rest_of_line(at);  // face colours
   }
   return mesh;
 }
