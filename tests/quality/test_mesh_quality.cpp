@@ -244,7 +244,7 @@ TEST_CASE("bad mesh files are reported with file and line", "[quality][io][bad]"
   CHECK_THROWS_AS(read_surface_mesh(unknown.path()), InputError);
   // Counts and indices that no double-to-integer cast may see: refused with
   // the file and line, not reported as negative numbers.
-  for (const char* text : {"OFF\n1e19 1 0\n", "OFF\ninf 1 0\n", "OFF\nnan 1 0\n", "OFF\n3 1000000 0\n0 0 0\n",
+  for (const char* text : {"OFF\n3 1 0\n0 0 0\n1e308 0 0\n0 1 0\n3 0 1 2\n", "OFF\n1e19 1 0\n", "OFF\ninf 1 0\n", "OFF\nnan 1 0\n", "OFF\n3 1000000 0\n0 0 0\n",
                            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1e300\n"}) {
     INFO(text);
     test::TempFile off("count.off", text);

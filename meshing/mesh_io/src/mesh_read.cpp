@@ -34,9 +34,15 @@ void add_polygon(SurfaceMesh& mesh, const std::vector<long>& corners, const std:
     mesh.triangles.push_back({static_cast<int>(corners[0]), static_cast<int>(corners[k]), static_cast<int>(corners[k + 1])});
 }
 
+// Coordinates beyond this (Angstrom) are no molecular mesh, and their
+// products (areas, volumes, cross products in the grader) overflow a double.
+constexpr double kMaxCoordinate = 1e15;
+
 Eigen::Vector3d checked_point(double x, double y, double z, const std::string& path, long line) {
   const Eigen::Vector3d p(x, y, z);
   if (!p.allFinite()) input_error(path, line, "non-finite vertex coordinate");
+  if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
+    input_error(path, line, "vertex coordinate beyond +-1e15 A: not a molecular mesh");
   return p;
 }
 
