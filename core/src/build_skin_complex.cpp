@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 #include <limits>
 #include <numeric>
@@ -21,18 +20,6 @@ using SkinComplexCoface = SkinComplex::Coface;
 
 using K = detail::RtKernel;
 using Regular = detail::RegularTriangulation<int>;
-
-using Key = std::array<int, 4>;  // ascending ball indices, padded with -1
-
-// The first `count` ids ascending, the rest -1 (an insertion sort: std::sort
-// on four ints draws a false -Warray-bounds from GCC 12).
-Key make_key(std::array<int, 4> ids, int count) {
-  for (int i = 1; i < count; ++i)
-    for (int j = i; j > 0 && ids[static_cast<size_t>(j - 1)] > ids[static_cast<size_t>(j)]; --j)
-      std::swap(ids[static_cast<size_t>(j - 1)], ids[static_cast<size_t>(j)]);
-  for (int i = count; i < 4; ++i) ids[static_cast<size_t>(i)] = -1;
-  return ids;
-}
 
 // Centre z_X (equal power to every ball of X within aff(delta_X)), size R2 and
 // the projector onto the directions of aff(delta_X) (docs/math.md section 3).
@@ -127,14 +114,12 @@ void add_constraints_beyond_flat_cofaces(std::vector<MixedCell>& cells, const st
         for (const int t : beyond)
           for (int j = 0; j <= cells[static_cast<size_t>(t)].dim; ++j) {
             const int ball = cells[static_cast<size_t>(t)].balls[static_cast<size_t>(j)];
-            if (!std::binary_search(cluster_balls.begin(), cluster_balls.end(), ball))
-              {
-              SkinComplexCoface beyond_flat;
-              beyond_flat.ball = ball;
-              beyond_flat.cell = t;
-              beyond_flat.beyond = true;
-              extra[static_cast<size_t>(x)].push_back(beyond_flat);
-            }
+            if (std::binary_search(cluster_balls.begin(), cluster_balls.end(), ball)) continue;
+            SkinComplexCoface beyond_flat;
+            beyond_flat.ball = ball;
+            beyond_flat.cell = t;
+            beyond_flat.beyond = true;
+            extra[static_cast<size_t>(x)].push_back(beyond_flat);
           }
       }
   }
@@ -150,12 +135,16 @@ void add_constraints_beyond_flat_cofaces(std::vector<MixedCell>& cells, const st
   coface_offset = std::move(offset);
 }
 
+void check_finite(const std::vector<Ball>& balls) {
+  for (const Ball& b : balls)
+    if (!b.center.allFinite() || !std::isfinite(b.weight)) contract_error("ball with a non-finite centre or weight");
+}
+
 void check_input(const std::vector<Ball>& balls, const SkinComplexOptions& options) {
   if (!(options.shrink > 0.0 && options.shrink < 1.0))
     contract_error("shrink factor must lie in (0,1), got " + std::to_string(options.shrink));
   if (balls.empty()) contract_error("cannot build a skin complex of no balls");
-  for (const Ball& b : balls)
-    if (!b.center.allFinite() || !std::isfinite(b.weight)) contract_error("ball with a non-finite centre or weight");
+  check_finite(balls);
 }
 
 }  // namespace
@@ -167,10 +156,10 @@ struct SkinComplexBuilder {
   static void add_simplices(const Regular& rt, SkinComplex& sc) {
     const int n = static_cast<int>(sc.balls_.size());
     std::vector<MixedCell>& cells = sc.cells_;
-    auto add = [&](std::array<int, 4> ids, int count) {
+    auto add = [&](std::array<int, 4> ids, int count) {  // unused entries of ids are -1
       MixedCell c;
       c.dim = count - 1;
-      c.balls = make_key(ids, count);
+      c.balls = SkinComplex::ball_tuple(ids);
       cells.push_back(c);
     };
     sc.vertex_cell_.assign(static_cast<size_t>(n), -1);
@@ -185,7 +174,7 @@ struct SkinComplexBuilder {
         add({e->first->vertex(e->second)->info(), e->first->vertex(e->third)->info(), -1, -1}, 2);
     if (rt.dimension() >= 2)
       for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
-        std::array<int, 4> ids{};
+        std::array<int, 4> ids{{-1, -1, -1, -1}};
         for (int k = 0; k < 3; ++k) ids[static_cast<size_t>(k)] = f->first->vertex((f->second + 1 + k) & 3)->info();
         add(ids, 3);
       }
@@ -263,8 +252,7 @@ struct SkinComplexBuilder {
 
   static SkinComplex moved(const SkinComplex& from, std::vector<Ball> balls) {
     if (balls.size() != from.balls_.size()) contract_error("with_balls: the number of balls differs from the complex's");
-    for (const Ball& b : balls)
-      if (!b.center.allFinite() || !std::isfinite(b.weight)) contract_error("ball with a non-finite centre or weight");
+    check_finite(balls);
     SkinComplex sc = from;
     sc.balls_ = std::move(balls);
     for (MixedCell& c : sc.cells_) {

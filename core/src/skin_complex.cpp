@@ -3,6 +3,8 @@
 // and curvature.
 #include "skinmesh/core/skin_complex.hpp"
 
+#include "skinmesh/core/quadratic.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -24,10 +26,15 @@ struct Violation {
   int target = -1;
 };
 
-// The cell's quadric along the line x = a + t dir (docs/math.md section 3):
-//   Q_X(a + t dir) = A t^2 + B t + C,
+// Q_X at y = x - z_X with py = P y (docs/math.md section 3):
 //   Q_X(x) = (1-s)|(I-P)(x-z)|^2 - s|P(x-z)|^2 + s(1-s) R2.
-// The one place Q_X is written; with dir = 0, C is Q_X(a).
+// The one place Q_X is written.
+double quadric_at(const MixedCell& cell, double s, const Eigen::Vector3d& y, const Eigen::Vector3d& py) {
+  return (1 - s) * (y - py).squaredNorm() - s * py.squaredNorm() + s * (1 - s) * cell.R2;
+}
+
+// The cell's quadric along the line x = a + t dir: A t^2 + B t + C, with
+// C = Q_X(a).
 struct LineQuadric {
   double A = 0, B = 0, C = 0;
 };
@@ -37,33 +44,14 @@ LineQuadric quadric_on_line(const MixedCell& cell, double s, const Eigen::Vector
   LineQuadric q;
   q.A = (1 - s) * (dir - pd).squaredNorm() - s * pd.squaredNorm();
   q.B = 2.0 * ((1 - s) * (y0 - py).dot(dir - pd) - s * py.dot(pd));
-  q.C = (1 - s) * (y0 - py).squaredNorm() - s * py.squaredNorm() + s * (1 - s) * cell.R2;
+  q.C = quadric_at(cell, s, y0, py);
   return q;
 }
 
-// grad F = grad Q_X / (1-s) = 2 (I-P) y - 2s/(1-s) P y at y = x - z; its
-// Hessian, constant on the cell, is 2 (I-P) - 2s/(1-s) P.
-Eigen::Vector3d skin_gradient(const MixedCell& cell, double s, const Eigen::Vector3d& x) {
-  const Eigen::Vector3d y = x - cell.center;
-  const Eigen::Vector3d py = cell.P * y;
+// grad F = grad Q_X / (1-s) = 2 (I-P) y - 2s/(1-s) P y; its Hessian,
+// constant on the cell, is 2 (I-P) - 2s/(1-s) P.
+Eigen::Vector3d skin_gradient(double s, const Eigen::Vector3d& y, const Eigen::Vector3d& py) {
   return 2.0 * (y - py) - (2.0 * s / (1 - s)) * py;
-}
-
-// Roots of A t^2 + B t + C in ascending order (the numerically stable form).
-int quadratic_roots(const LineQuadric& q, double roots[2]) {
-  int count = 0;
-  const double scale = std::abs(q.A) + std::abs(q.B) + std::abs(q.C);
-  if (std::abs(q.A) <= 1e-15 * scale) {
-    if (q.B != 0.0) roots[count++] = -q.C / q.B;
-    return count;
-  }
-  const double disc = q.B * q.B - 4 * q.A * q.C;
-  if (disc < 0) return 0;
-  const double root = -0.5 * (q.B + std::copysign(std::sqrt(disc), q.B));
-  roots[count++] = root / q.A;
-  if (root != 0.0) roots[count++] = q.C / root;
-  if (count == 2 && roots[0] > roots[1]) std::swap(roots[0], roots[1]);
-  return count;
 }
 
 }  // namespace
@@ -81,19 +69,26 @@ long SkinComplex::degenerate_cell_count() const {
 }
 
 double SkinComplex::quadric(int c, const Eigen::Vector3d& x) const {
-  return quadric_on_line(cells_[static_cast<size_t>(c)], shrink_, x, Eigen::Vector3d::Zero()).C;
+  const MixedCell& cell = cells_[static_cast<size_t>(c)];
+  const Eigen::Vector3d y = x - cell.center;
+  return quadric_at(cell, shrink_, y, cell.P * y);
 }
 
 int SkinComplex::find_cell(std::array<int, 4> balls) const {
-  // Ascending ball indices, the unused entries (-1) last: the order of MixedCell::balls.
-  for (size_t i = 1; i < balls.size(); ++i)
-    for (size_t j = i; j > 0; --j) {
-      const int a = balls[j - 1], b = balls[j];
-      if (!(a < 0 ? b >= 0 : b >= 0 && b < a)) break;
-      std::swap(balls[j - 1], balls[j]);
-    }
-  const auto it = cell_of_balls_.find(balls);
+  const auto it = cell_of_balls_.find(ball_tuple(balls));
   return it == cell_of_balls_.end() ? -1 : it->second;
+}
+
+std::array<int, 4> SkinComplex::ball_tuple(std::array<int, 4> ids) {
+  // An insertion sort: std::sort on four ints draws a false -Warray-bounds
+  // from GCC 12. a goes after b when a is unused, or both are used and a > b.
+  for (size_t i = 1; i < ids.size(); ++i)
+    for (size_t j = i; j > 0; --j) {
+      const int a = ids[j - 1], b = ids[j];
+      if (!(a < 0 ? b >= 0 : b >= 0 && b < a)) break;
+      std::swap(ids[j - 1], ids[j]);
+    }
+  return ids;
 }
 
 std::array<int, 3> SkinComplex::grid_cell_of(const Eigen::Vector3d& x) const {
@@ -205,8 +200,10 @@ SkinEval SkinComplex::evaluate(const Eigen::Vector3d& x, int hint) const {
   SkinEval e;
   e.cell = locate(x, hint);
   const MixedCell& cell = cells_[static_cast<size_t>(e.cell)];
-  e.value = quadric(e.cell, x) / (1 - shrink_);  // F = Q_X / (1-s) on mu_X
-  e.gradient = skin_gradient(cell, shrink_, x);
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d py = cell.P * y;
+  e.value = quadric_at(cell, shrink_, y, py) / (1 - shrink_);  // F = Q_X / (1-s) on mu_X
+  e.gradient = skin_gradient(shrink_, y, py);
   return e;
 }
 
@@ -379,7 +376,7 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
     const double hi = std::min(exit.t, 1.0);
     const LineQuadric q = quadric_on_line(cells_[static_cast<size_t>(c)], shrink_, a, dir);
     double roots[2];
-    const int count = quadratic_roots(q, roots);
+    const int count = quadratic_roots(q.A, q.B, q.C, 1e-15, roots);
     const double eps = 1e-13;
     for (int r = 0; r < count; ++r) {
       const double u = roots[r];
@@ -417,7 +414,8 @@ PrincipalCurvatures SkinComplex::curvature(const Eigen::Vector3d& x, int c) cons
   const double s = shrink_;
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   // F = Q/(1-s): the gradient of skin_gradient, and its constant Hessian.
-  const Eigen::Vector3d g = skin_gradient(cell, s, x);
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d g = skin_gradient(s, y, cell.P * y);
   const Eigen::Matrix3d H = 2.0 * (I - cell.P) - (2.0 * s / (1 - s)) * cell.P;
   PrincipalCurvatures pc;
   const double gn = g.norm();

@@ -1,5 +1,7 @@
 #include "skinmesh/morph/events.hpp"
 
+#include "skinmesh/core/quadratic.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -45,19 +47,8 @@ std::vector<TopologyEvent> topology_events(const std::vector<CellSize>& sizes) {
   for (int c = 0; c < static_cast<int>(sizes.size()); ++c) {
     const CellSize& q = sizes[static_cast<size_t>(c)];
     if (!q.overlay_cell) continue;
-    const double scale = std::abs(q.a) + std::abs(q.b) + std::abs(q.c);
     double roots[2];
-    int count = 0;
-    if (std::abs(q.a) <= 1e-14 * scale) {
-      if (q.b != 0) roots[count++] = -q.c / q.b;
-    } else {
-      const double disc = q.b * q.b - 4 * q.a * q.c;
-      if (disc >= 0) {
-        const double r = -0.5 * (q.b + std::copysign(std::sqrt(disc), q.b));
-        roots[count++] = r / q.a;
-        if (r != 0) roots[count++] = q.c / r;
-      }
-    }
+    const int count = quadratic_roots(q.a, q.b, q.c, 1e-14, roots);
     for (int k = 0; k < count; ++k)
       if (roots[k] > 0 && roots[k] < 1) events.push_back({roots[k], c});
   }

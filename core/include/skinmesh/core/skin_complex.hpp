@@ -144,6 +144,8 @@ class SkinComplex {
   Projection project_onto(const Eigen::Vector3d& x, int hint, double tolerance) const;
   std::optional<SegmentCrossing> nearest_crossing_on_rays(const Eigen::Vector3d& x, double reach, int hint) const;
   int locate_by_search(const Eigen::Vector3d& x) const;
+  // Ball ids ascending, unused entries (-1) last: the order of MixedCell::balls.
+  static std::array<int, 4> ball_tuple(std::array<int, 4> ids);
   std::array<int, 3> grid_cell_of(const Eigen::Vector3d& x) const;  // clamped to the grid
   size_t grid_bucket(const std::array<int, 3>& g) const {
     return (static_cast<size_t>(g[2]) * static_cast<size_t>(grid_size_[1]) + static_cast<size_t>(g[1])) *
