@@ -4,6 +4,9 @@
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/morph/transport.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 
 namespace skinmesh {
@@ -31,38 +34,110 @@ void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria) {
 }
 
 // Transport (eq. 19) or, off the cell, projection onto the new skin from
-// the transported point. False when a vertex cannot be put on the skin.
-bool Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const {
-  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
-    const int cell = mesh.cells[v];
-    const TransportedPoint moved = transport(current_, next, cell, mesh.vertices[v]);
-    const Eigen::Vector3d start = moved.status == TransportStatus::size_vanished ? mesh.vertices[v] : moved.point;
-    if (moved.status == TransportStatus::in_cell) {
-      mesh.vertices[v] = moved.point;
-      ++stats.moved;
-    } else {
-      const Projection p = next.project(start, cell, 1e-14);
-      if (!p.converged) return false;
-      mesh.vertices[v] = p.point;
-      mesh.cells[v] = p.cell;
-      ++stats.relocated;
+// the transported point. Returns per vertex 1 where it could not be put on
+// the skin (lost), else 0.
+std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const {
+  const size_t n = mesh.vertices.size();
+  std::vector<char> state(n, 0);  // 0 moved, 1 lost, 2 relocated
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const int cell = mesh.cells[v];
+      const TransportedPoint moved = transport(current_, next, cell, mesh.vertices[v]);
+      if (moved.status == TransportStatus::in_cell) {
+        mesh.vertices[v] = moved.point;
+      } else {
+        const Eigen::Vector3d start = moved.status == TransportStatus::size_vanished ? mesh.vertices[v] : moved.point;
+        const Projection p = next.project(start, cell, 1e-14);
+        if (!p.converged) {
+          state[v] = 1;
+          continue;
+        }
+        mesh.vertices[v] = p.point;
+        mesh.cells[v] = p.cell;
+        state[v] = 2;
+      }
+      mesh.normals[v] = next.evaluate(mesh.vertices[v], mesh.cells[v]).gradient.normalized();
     }
-    mesh.normals[v] = next.evaluate(mesh.vertices[v], mesh.cells[v]).gradient.normalized();
+  });
+  std::vector<char> lost(n, 0);
+  for (size_t v = 0; v < n; ++v) {
+    lost[v] = state[v] == 1;
+    stats.moved += state[v] == 0;
+    stats.relocated += state[v] == 2;
+    stats.lost += state[v] == 1;
   }
-  return true;
+  return lost;
 }
 
 long Morph::count_bad_triangles(const SkinComplex& next, const SurfaceMesh& mesh) const {
-  long bad = 0;
-  for (const auto& t : mesh.triangles) {
-    const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
-                                                 mesh.vertices[static_cast<size_t>(t[1])],
-                                                 mesh.vertices[static_cast<size_t>(t[2])]};
-    const auto restricted =
-        restricted_triangle(next, corners, options_.frames.tolerance, mesh.cells[static_cast<size_t>(t[0])]);
-    bad += !restricted || triangle_defect(next, *restricted, options_.frames) != TriangleDefect::none;
+  const size_t n = mesh.triangles.size();
+  std::vector<char> bad(n, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const auto& t = mesh.triangles[i];
+      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
+                                                   mesh.vertices[static_cast<size_t>(t[1])],
+                                                   mesh.vertices[static_cast<size_t>(t[2])]};
+      const auto restricted =
+          restricted_triangle(next, corners, options_.frames.tolerance, mesh.cells[static_cast<size_t>(t[0])]);
+      bad[i] = !restricted || triangle_defect(next, *restricted, options_.frames) != TriangleDefect::none;
+    }
+  });
+  return std::count(bad.begin(), bad.end(), 1);
+}
+
+// Along every mesh edge shorter than crowded_below times the smaller target
+// length at its ends, the vertex with the larger index goes (unless its
+// partner goes already). Returns how many were marked in `drop`.
+long Morph::mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const {
+  std::vector<double> target(mesh.vertices.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, target.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      target[v] = target_edge_length(next, mesh.vertices[v], mesh.cells[v], options_.frames);
+  });
+  long marked = 0;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      size_t a = static_cast<size_t>(t[static_cast<size_t>(k)]), b = static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)]);
+      if (a > b) std::swap(a, b);
+      if (drop[a] || drop[b]) continue;
+      const double limit = options_.crowded_below * std::min(target[a], target[b]);
+      if ((mesh.vertices[a] - mesh.vertices[b]).squaredNorm() < limit * limit) {
+        drop[b] = 1;
+        ++marked;
+      }
+    }
+  return marked;
+}
+
+// Remeshes the frame from the transported vertices not dropped; false when
+// the mesher cannot (then the caller rebuilds from scratch).
+bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
+  std::vector<SkinSample> samples;
+  std::vector<long> sample_ids;
+  samples.reserve(moved.vertices.size());
+  for (size_t v = 0; v < moved.vertices.size(); ++v) {
+    if (drop[v]) continue;
+    samples.push_back({moved.vertices[v], moved.cells[v]});
+    sample_ids.push_back(frame_.ids[v]);
   }
-  return bad;
+  SkinMeshResult made = remesh_skin(next, samples, options_.frames);
+  if (made.status != MeshingStatus::ok) return false;
+  std::vector<long> ids(made.mesh.vertices.size());
+  long kept = 0;
+  for (size_t v = 0; v < ids.size(); ++v) {
+    const long origin = made.origins[v];
+    ids[v] = origin >= 0 ? sample_ids[static_cast<size_t>(origin)] : next_id_++;
+    kept += origin >= 0;
+  }
+  const MeshingStats& m = made.stats;
+  frame_.stats.repaired = true;
+  frame_.stats.inserted = static_cast<long>(ids.size()) - kept;
+  frame_.stats.removed = static_cast<long>(moved.vertices.size()) - kept;
+  frame_.stats.repairs = m.inserted_size + m.inserted_shape + m.inserted_distance + m.inserted_topology;
+  frame_.mesh = std::move(made.mesh);
+  frame_.ids = std::move(ids);
+  return true;
 }
 
 const MorphFrame& Morph::advance_to(double t) {
@@ -74,14 +149,22 @@ const MorphFrame& Morph::advance_to(double t) {
   stats.events = std::count_if(events_.begin(), events_.end(),
                                [&](const TopologyEvent& e) { return e.t > t_ && e.t <= t; });
   SurfaceMesh moved = frame_.mesh;
-  const bool on_skin = stats.events == 0 && move_vertices(next, moved, stats);
-  if (on_skin) stats.bad_triangles = count_bad_triangles(next, moved);
+  std::vector<char> drop = move_vertices(next, moved, stats);
+  if (stats.lost == 0) stats.bad_triangles = count_bad_triangles(next, moved);
+  stats.crowded = mark_crowded(next, moved, drop);
   t_ = t;
   frame_.stats = stats;
-  if (on_skin && stats.bad_triangles == 0) {
+  if (stats.events == 0 && stats.lost == 0 && stats.crowded == 0 && stats.bad_triangles == 0) {
     frame_.mesh = std::move(moved);  // ids stay: every vertex survives
   } else {
-    rebuild(next, options_.frames);
+    const auto repair_start = Clock::now();
+    if (!repair(next, moved, drop)) {
+      const long before = static_cast<long>(frame_.mesh.vertices.size());
+      rebuild(next, options_.frames);
+      frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
+      frame_.stats.removed = before;
+    }
+    frame_.stats.seconds_repair = seconds_since(repair_start);
   }
   current_ = next;
   frame_.stats.t = t;

@@ -309,3 +309,46 @@ TEST_CASE("restricted_triangle judges the mesher's own triangles as the mesher d
   CHECK(too_big > static_cast<long>(r.mesh.triangles.size()) / 2);
   CHECK(too_far > 0);
 }
+
+TEST_CASE("remesh_skin keeps the given samples, seeds what they miss, and every guarantee holds",
+          "[mesher][remesh]") {
+  const std::vector<Ball> balls = balls_from_molecule(read_molecule(data_file("pept.pdb")), 0.5);
+  const SkinComplex complex = build_skin_complex(balls, {0.5});
+  MeshingOptions options;
+  options.min_angle = 20.0;
+  const SkinMeshResult first = mesh_skin(complex, options);
+  REQUIRE(first.status == MeshingStatus::ok);
+  CHECK(first.origins.empty());
+  // Every other vertex of the mesh as samples, plus a far ball with no sample
+  // on its skin: refinement fills the gaps, seeding finds the new component.
+  std::vector<SkinSample> samples;
+  for (size_t v = 0; v < first.mesh.vertices.size(); v += 2)
+    samples.push_back({first.mesh.vertices[v], first.mesh.cells[v]});
+  std::vector<Ball> more = balls;
+  more.push_back({Eigen::Vector3d(60, 0, 0), 2.0 * 2.0 / 0.5});
+  const SkinComplex wider = build_skin_complex(more, {0.5});
+  const SkinMeshResult again = remesh_skin(wider, samples, options);
+  INFO(again.message);
+  REQUIRE(again.status == MeshingStatus::ok);
+  REQUIRE(again.origins.size() == again.mesh.vertices.size());
+  std::vector<int> used(samples.size(), 0);
+  long fresh = 0;
+  for (size_t v = 0; v < again.origins.size(); ++v) {
+    const long o = again.origins[v];
+    if (o < 0) {
+      ++fresh;
+      continue;
+    }
+    REQUIRE(o < static_cast<long>(samples.size()));
+    CHECK(++used[static_cast<size_t>(o)] == 1);
+    CHECK(again.mesh.vertices[v] == samples[static_cast<size_t>(o)].point);  // kept exactly
+  }
+  CHECK(std::count(used.begin(), used.end(), 1) == static_cast<long>(samples.size()));
+  CHECK(fresh > 0);
+  GuaranteeOptions bound;
+  bound.min_angle = 20.0;
+  const GuaranteeReport report = check_guarantees(again.mesh, more, 0.5, bound);
+  CHECK(report.all_hold());
+  CHECK(report.quality.components == grade_mesh(first.mesh).components + 1);
+  CHECK(report.quality.euler == grade_mesh(first.mesh).euler + 2);
+}

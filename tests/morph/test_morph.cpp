@@ -16,6 +16,28 @@
 
 using namespace skinmesh;
 
+namespace {
+
+// Ids: unique in the frame; a vertex of the previous frame that survives
+// keeps its id; every other id is new (never seen in any earlier frame); the
+// frame's counts of inserted and removed vertices match.
+void check_ids(const std::vector<long>& before, const MorphFrame& f, std::set<long>& seen) {
+  const std::set<long> now(f.ids.begin(), f.ids.end());
+  CHECK(now.size() == f.ids.size());
+  const std::set<long> previous(before.begin(), before.end());
+  long kept = 0;
+  for (long id : now) {
+    if (previous.count(id)) ++kept;
+    else CHECK(seen.count(id) == 0);
+  }
+  CHECK(static_cast<long>(now.size()) - kept == f.stats.inserted);
+  CHECK(static_cast<long>(previous.size()) - kept == f.stats.removed);
+  if (!f.stats.repaired && !f.stats.full_rebuild) CHECK(f.ids == before);
+  seen.insert(now.begin(), now.end());
+}
+
+}  // namespace
+
 TEST_CASE("morph frames of 2k39 model 1 -> 2 are quality meshes of B(t)", "[morph][frames]") {
   const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
   const auto m2 = test::centred_model(test::data_file("2k39_3models.pdb"), 2);
@@ -23,7 +45,7 @@ TEST_CASE("morph frames of 2k39 model 1 -> 2 are quality meshes of B(t)", "[morp
   Morph morph = prepare_morph(m1, m2, 0.3, options);
   const MorphOracle oracle(m1, m2, 0.5);
   std::set<long> seen(morph.frame().ids.begin(), morph.frame().ids.end());
-  long rebuilds = 0, transported = 0;
+  long rebuilds = 0, kept = 0;
   for (double t : {0.302, 0.304, 0.306, 0.31, 0.32, 0.35}) {
     INFO("t = " << t);
     const std::vector<long> before = morph.frame().ids;
@@ -31,7 +53,6 @@ TEST_CASE("morph frames of 2k39 model 1 -> 2 are quality meshes of B(t)", "[morp
     INFO(f.stats.moved << " moved, " << f.stats.relocated << " relocated, " << f.stats.bad_triangles
                        << " bad triangles, " << f.stats.events << " events, rebuilt " << f.stats.full_rebuild);
     rebuilds += f.stats.full_rebuild;
-    transported += !f.stats.full_rebuild;
     double worst = 0;
     for (const Eigen::Vector3d& v : f.mesh.vertices) {
       const MorphOracleResult o = oracle.evaluate(v, t);
@@ -48,21 +69,17 @@ TEST_CASE("morph frames of 2k39 model 1 -> 2 are quality meshes of B(t)", "[morp
     const MeshQuality fresh = grade_mesh(mesh_skin(morph.complex(), options.frames).mesh, topology_only);
     CHECK(q.components == fresh.components);
     CHECK(q.euler == fresh.euler);
-    if (!f.stats.full_rebuild) {
-      CHECK(f.ids == before);
-    } else {
-      for (long id : f.ids) CHECK(seen.count(id) == 0);  // new vertices get new ids
-    }
-    seen.insert(f.ids.begin(), f.ids.end());
+    kept += f.stats.vertices - f.stats.inserted;
+    check_ids(before, f, seen);
   }
-  // Without local repair most frames of a real molecule are rebuilt: a step
-  // of 0.002 already leaves dozens of triangles outside the criteria.
-  INFO(transported << " frames transported, " << rebuilds << " rebuilt");
-  CHECK(transported + rebuilds == 6);
+  // Repair keeps the transported vertices: no frame is rebuilt, and most
+  // vertices survive every step.
+  CHECK(rebuilds == 0);
+  CHECK(kept > 6 * static_cast<long>(morph.frame().mesh.vertices.size()) / 2);
   CHECK_THROWS_AS(morph.advance_to(0.2), ContractError);
 }
 
-TEST_CASE("morph frames of two balls: transported until their skins join, then rebuilt", "[morph][frames]") {
+TEST_CASE("morph frames of two balls: transported until their skins join, repaired there", "[morph][frames]") {
   const test::TwoBallMorph two;
   MorphOptions options;
   Morph morph = prepare_morph(two.source, two.target, 0.05, options);
@@ -70,9 +87,10 @@ TEST_CASE("morph frames of two balls: transported until their skins join, then r
   REQUIRE_FALSE(morph.events().empty());
   const double event = morph.events().front().t;
   long transported = 0;
-  std::vector<long> ids = morph.frame().ids;
+  std::set<long> seen(morph.frame().ids.begin(), morph.frame().ids.end());
   for (double t = 0.1; t < 0.96; t += 0.05) {
     INFO("t = " << t << ", first event at " << event);
+    const std::vector<long> before = morph.frame().ids;
     const MorphFrame& f = morph.advance_to(t);
     double worst = 0;
     for (const Eigen::Vector3d& v : f.mesh.vertices) worst = std::max(worst, oracle.evaluate(v, t).distance());
@@ -81,12 +99,10 @@ TEST_CASE("morph frames of two balls: transported until their skins join, then r
     CHECK(q.min_angle >= options.frames.min_angle - 1e-9);
     CHECK((q.closed && q.manifold && q.oriented && q.self_intersecting_pairs == 0));
     CHECK(q.components == (two.joined(oracle, t, 200) ? 1 : 2));
-    if (!f.stats.full_rebuild) {
-      CHECK(f.ids == ids);
-      ++transported;
-    }
-    if (f.stats.events > 0) CHECK(f.stats.full_rebuild);
-    ids = f.ids;
+    transported += !f.stats.repaired && !f.stats.full_rebuild;
+    if (f.stats.events > 0) CHECK(f.stats.repaired);
+    CHECK_FALSE(f.stats.full_rebuild);
+    check_ids(before, f, seen);
   }
   INFO(transported << " of 18 frames transported");
   CHECK(transported > 0);

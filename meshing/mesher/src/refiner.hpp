@@ -153,7 +153,8 @@ class Refiner {
     max_radius_edge_ = 1.0 / (2.0 * std::sin(options.min_angle * M_PI / 180.0));
   }
 
-  SkinMeshResult run();
+  // Seeds the skin, or starts from `samples` (remesh_skin) when given.
+  SkinMeshResult run(const std::vector<SkinSample>* samples = nullptr);
 
  private:
   // Calls visit(facet, key) once for every finite facet with a vertex in
@@ -175,7 +176,9 @@ class Refiner {
   FacetEval evaluate(const Facet& facet) const;
   std::optional<DualEdge> dual_edge(Cell_handle c, int i, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                                     const Eigen::Vector3d& p2) const;
-  void insert_seeds();
+  // Seeds closer than spacing times the target edge length to a sample are left out.
+  void insert_seeds(double spacing);
+  void insert_samples(const std::vector<SkinSample>& samples);
   Vertex_handle insert(const Eigen::Vector3d& p, int cell, Cell_handle hint);
   void push_if_bad(const FacetEval& e);
   void push_repair(FacetEval e);  // a vertex-star repair: insert its ball centre even without a defect
@@ -185,7 +188,7 @@ class Refiner {
   bool global_pass(std::vector<FacetEval>* restricted);
   bool repair_stars(const std::vector<FacetEval>& restricted, const std::vector<Vertex_handle>& vertices);
   void local_passes();
-  SurfaceMesh extract(const std::vector<FacetEval>& restricted) const;
+  SurfaceMesh extract(const std::vector<FacetEval>& restricted, std::vector<long>* origins) const;
   void report(const char* stage, Report when, long pending = 0);
   void refine_until_clean(std::vector<FacetEval>* restricted);
 
@@ -216,6 +219,7 @@ class Refiner {
   double box_radius_ = 0;
   double max_radius_edge_ = 1;
   int next_id_ = 0;
+  int sample_ids_ = 0;  // ids below this are the given samples' indices (remesh_skin)
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();
 };

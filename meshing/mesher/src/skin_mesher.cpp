@@ -154,14 +154,17 @@ Vertex_handle Refiner::insert(const Eigen::Vector3d& point, int cell, Cell_handl
   return v;
 }
 
-void Refiner::insert_seeds() {
+void Refiner::insert_seeds(double spacing) {
   // Seeds closer than a quarter of the target edge length to a kept one are
   // dropped: a pair of nearly coincident critical points (common where a
   // critical point sits near a cell boundary) would otherwise force refinement
   // down to their distance. A component still keeps its seeds unless all of
   // them lie that close to another component, which the curvature sizing rules
   // out (a component that small has curvature radius, hence target length, of
-  // its own size or less).
+  // its own size or less). After samples (remesh_skin) the spacing is a whole
+  // target length: every point of a meshed part of the skin lies within a
+  // surface Delaunay ball radius (target / sqrt 3) of a sample, so only the
+  // seeds of parts the samples miss are kept.
   const auto seeds = detail::critical_point_seeds(complex_);
   Cell_handle hint;
   for (const auto& s : seeds) {
@@ -169,14 +172,41 @@ void Refiner::insert_seeds() {
     if (dt_.number_of_vertices() > 0) {
       const Vertex_handle nearest = dt_.nearest_vertex(p, hint);
       const Eigen::Vector3d q = to_eigen(nearest->point());
-      const double spacing = 0.25 * std::min(target_edge_length(complex_, s.point, s.cell, options_),
-                                             target_edge_length(complex_, q, nearest->info().cell, options_));
-      if ((q - s.point).norm() < spacing) continue;
+      const double apart = spacing * std::min(target_edge_length(complex_, s.point, s.cell, options_),
+                                              target_edge_length(complex_, q, nearest->info().cell, options_));
+      if ((q - s.point).norm() < apart) continue;
     }
     const Vertex_handle v = insert(s.point, s.cell, hint);
     hint = v->cell();
     ++stats_.seeds;
   }
+}
+
+// The given samples in one spatially sorted batch (CGAL sorts a range insert
+// along a Hilbert curve), each with its index as id; then every cell is
+// stamped as of this moment, so that the first global pass can tell later
+// changes from the batch.
+void Refiner::insert_samples(const std::vector<SkinSample>& samples) {
+  std::vector<std::pair<K::Point_3, VertexInfo>> points;
+  points.reserve(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    Eigen::Vector3d p = samples[i].point;
+    int cell = samples[i].cell;
+    const SkinEval check = complex_.evaluate(p, cell);
+    if (std::abs(check.value) > 1e-13 * check.gradient.norm()) {
+      const Projection polished = complex_.project(p, check.cell, 1e-14);
+      if (!polished.converged) continue;  // a sample that cannot be put on the skin is left out
+      p = polished.point;
+      cell = polished.cell;
+    } else {
+      cell = check.cell;
+    }
+    points.push_back({K::Point_3(p[0], p[1], p[2]), VertexInfo{cell, static_cast<int>(i)}});
+  }
+  dt_.insert(points.begin(), points.end());
+  sample_ids_ = next_id_ = static_cast<int>(samples.size());
+  ++stamp_;
+  for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) c->info().value = stamp_;
 }
 
 void Refiner::push_if_bad(const FacetEval& e) {
@@ -408,8 +438,9 @@ bool Refiner::repair_stars(const std::vector<FacetEval>& restricted, const std::
   return clean;
 }
 
-SurfaceMesh Refiner::extract(const std::vector<FacetEval>& restricted) const {
+SurfaceMesh Refiner::extract(const std::vector<FacetEval>& restricted, std::vector<long>* origins) const {
   SurfaceMesh mesh;
+  origins->clear();
   std::vector<int> index(static_cast<size_t>(next_id_), -1);
   for (const FacetEval& e : restricted) {
     std::array<int, 3> t;
@@ -423,6 +454,7 @@ SurfaceMesh Refiner::extract(const std::vector<FacetEval>& restricted) const {
         mesh.vertices.push_back(p);
         mesh.normals.push_back(se.gradient.normalized());
         mesh.cells.push_back(se.cell);
+        origins->push_back(v->info().id < sample_ids_ ? v->info().id : -1);
       }
       t[static_cast<size_t>(k)] = slot;
     }
@@ -494,10 +526,11 @@ void Refiner::refine_until_clean(std::vector<FacetEval>* restricted) {
   }
 }
 
-SkinMeshResult Refiner::run() {
+SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
   const auto start = Clock::now();
   report("seeding", Report::now);
-  insert_seeds();
+  if (samples) insert_samples(*samples);
+  insert_seeds(samples ? 1.0 : 0.25);
   stats_.seconds_seeding = seconds_since(start);
   const auto refine_start = Clock::now();
   std::vector<FacetEval> restricted;
@@ -514,7 +547,8 @@ SkinMeshResult Refiner::run() {
     stats_.seconds_contracting = seconds_since(contract_start);
   }
   SkinMeshResult result;
-  result.mesh = extract(restricted);
+  result.mesh = extract(restricted, &result.origins);
+  if (!samples) result.origins.clear();
   stats_.seconds_total = seconds_since(start);
   result.stats = stats_;
   return result;
@@ -535,7 +569,9 @@ const char* meshing_status_name(MeshingStatus status) {
   return "unknown";
 }
 
-SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& options) {
+namespace {
+
+void check_options(const MeshingOptions& options) {
   if (!(options.min_angle > 0 && options.min_angle <= 30.0))
     contract_error("the angle bound must be in (0, 30] degrees (Delaunay refinement "
                                 "terminates for bounds up to about 30 degrees)");
@@ -547,6 +583,11 @@ SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& optio
   if (options.max_triangles <= 0) contract_error("the triangle budget must be positive");
   if (!(options.contract_below >= 0 && options.contract_below < 1))
     contract_error("the contraction threshold must be in [0, 1) times the target edge length");
+}
+
+SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSample>* samples,
+                           const MeshingOptions& options) {
+  check_options(options);
   std::optional<tbb::global_control> threads;
   if (options.threads > 0)
     threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
@@ -560,13 +601,24 @@ SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& optio
   }
   detail::Refiner refiner(complex, options);
   try {
-    return refiner.run();
+    return refiner.run(samples);
   } catch (const detail::RefinementStopped& stop) {
     SkinMeshResult result;
     result.status = stop.status;
     result.message = stop.message;
     return result;
   }
+}
+
+}  // namespace
+
+SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& options) {
+  return run_refiner(complex, nullptr, options);
+}
+
+SkinMeshResult remesh_skin(const SkinComplex& complex, const std::vector<SkinSample>& samples,
+                           const MeshingOptions& options) {
+  return run_refiner(complex, &samples, options);
 }
 
 }  // namespace skinmesh

@@ -5,10 +5,15 @@
 // projected back onto the new skin; every triangle is then judged by the
 // mesher's own criteria (restricted_triangle, triangle_defect).
 //
-// Not yet: local repair. A frame with a failing triangle, a vertex that
-// cannot be put back on the skin, or a topology event since the last frame
-// is rebuilt by the mesher from scratch, and FrameStats::full_rebuild says
-// so. Every frame is a correct mesh of the skin of B(t) either way.
+// Repair: a frame where a triangle fails, a vertex is lost (its cell's size
+// vanished and no skin point is near), transport crowded vertices, or a
+// critical topology event lies since the last frame, is remeshed from its
+// own transported vertices (remesh_skin): they are kept, crowded ones
+// removed, and restricted Delaunay refinement inserts points only where a
+// triangle fails, and seeds only on skin the vertices miss (a component
+// born, a neck opened). Only when that fails is the frame meshed from
+// scratch (FrameStats::full_rebuild). Every frame is a correct quality mesh
+// of the skin of B(t) either way.
 #pragma once
 
 #include "skinmesh/core/interpolation.hpp"
@@ -31,6 +36,10 @@ struct MorphOptions {
     o.min_angle = 20.0;     // degrees
     return o;
   }();
+  // A transported vertex nearer than this times the target edge length to
+  // a neighbour along a mesh edge is removed at the next repair (transport
+  // crowds vertices where a patch shrinks); it also triggers a repair.
+  double crowded_below = 0.2;
 };
 
 struct FrameStats {
@@ -39,9 +48,16 @@ struct FrameStats {
   long moved = 0;              // transported inside their cell (exactly onto the new skin)
   long relocated = 0;          // left their cell (or its size vanished) and were projected onto the new skin
   long bad_triangles = 0;      // failing the frame's criteria after the move
+  long crowded = 0;            // vertices removed because transport crowded them
+  long lost = 0;               // vertices that could not be put on the new skin (removed)
   long events = 0;             // critical topology events since the previous frame
-  bool full_rebuild = false;   // the frame was meshed from scratch
-  double seconds = 0;
+  bool repaired = false;       // the frame was remeshed from its transported vertices
+  long inserted = 0;           // new vertices (refinement and seeds)
+  long removed = 0;            // vertices of the previous frame not in this one
+  long repairs = 0;            // refinement insertions, each at a failing triangle
+  bool full_rebuild = false;   // the frame was meshed from scratch (repair failed)
+  double seconds = 0;          // the whole frame
+  double seconds_repair = 0;   // of which remeshing (or rebuilding)
 };
 
 struct MorphFrame {
@@ -66,8 +82,10 @@ class Morph {
   Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
         const MorphOptions& options);
   void rebuild(const SkinComplex& next, const MeshingOptions& criteria);
-  bool move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
+  bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
+  std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
   long count_bad_triangles(const SkinComplex& next, const SurfaceMesh& mesh) const;
+  long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
 
   std::vector<Ball> source_, target_;
   std::vector<BallPair> pairs_;

@@ -26,6 +26,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace skinmesh {
 
@@ -124,9 +125,31 @@ struct SkinMeshResult {
   std::string message;             // what happened, when status != ok (names no command-line flag)
   SurfaceMesh mesh;                // triangles oriented outward; normals and mixed cells per vertex; empty unless ok
   MeshingStats stats;
+  // remesh_skin only: per vertex of `mesh`, the index of the given sample it
+  // is, or -1 for a vertex that refinement or seeding added.
+  std::vector<long> origins;
 };
 
 // Throws ContractError for options out of range.
 SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& options = {});
+
+// A point on the skin and its mixed cell.
+struct SkinSample {
+  Eigen::Vector3d point;
+  int cell = -1;
+};
+
+// Restricted Delaunay refinement started from given samples on the skin (a
+// morph frame's transported vertices) instead of from seeds alone: the
+// samples are inserted in one spatially sorted batch, seeds are added only
+// where no sample lies within a target edge length (a component the samples
+// miss), and refinement then inserts points only where a restricted triangle
+// fails a criterion. Every guarantee of mesh_skin holds for the result; the
+// samples are kept (a sample without restricted triangles is dropped) and
+// result.origins says which output vertex is which sample. A sample off the
+// skin (|F| above rounding) is projected onto it first. Throws ContractError
+// for options out of range.
+SkinMeshResult remesh_skin(const SkinComplex& complex, const std::vector<SkinSample>& samples,
+                           const MeshingOptions& options = {});
 
 }  // namespace skinmesh

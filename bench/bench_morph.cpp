@@ -1,0 +1,264 @@
+// The morph against per-frame reconstruction (the paper's Table 4, Yan, Cheng
+// et al.), side by side in one run, each column in its own forked child:
+//   (a) each frame rebuilt from all m*n interpolated balls by CGAL's skin
+//       mesher (the paper's baseline; centres jittered by 1e-9 A, which CGAL
+//       needs on the cospherical groups of B(t));
+//   (b) each frame rebuilt by skinmesh's quality mesher from the live pairs
+//       (complex and mesh, at the morph's frame criteria);
+//   (c) the morph: the source side meshed once at the first frame, then every
+//       later frame transported and repaired (morph/morph.hpp).
+// (c) runs every frame; (a) and (b) cost the same at every frame and average
+// a sample spread over (0,1). Quality per column is measured with the clock
+// stopped: every frame graded (closed, manifold, oriented, self-intersections,
+// angles) and every vertex measured by the morph oracle (docs/math.md
+// section 4), which knows neither the complex nor the live pairs.
+//
+//   bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [PAIR...]
+//   PAIR: SOURCE:TARGET, a file optionally followed by #MODEL
+//   (default: pept:3al1, 3al1:1ubi, 1ubi:1hpv, 2k39_3models#1:#3 from data/)
+#include "cgal_reference.hpp"
+#include "forked.hpp"
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/morph/alignment.hpp"
+#include "skinmesh/morph/morph.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+using namespace skinmesh;
+
+namespace {
+
+constexpr double kShrink = 0.5;
+
+// One column's frames, accumulated; raw bytes through the child's pipe.
+struct Column {
+  double frames = 0, seconds = 0, seconds_first = 0, seconds_repair = 0;
+  double triangles = 0, below_20 = 0, min_angle = 180;
+  double max_error = 0, uncertified = 0;
+  double invalid_frames = 0;  // not closed, manifold and oriented, or self-intersecting
+  double repaired = 0, full_rebuilds = 0, inserted = 0, removed = 0, relocated = 0, vertices = 0;
+
+  void grade(const SurfaceMesh& mesh, const MorphOracle& oracle, double t) {
+    const MeshQuality q = grade_mesh(mesh);
+    frames += 1;
+    triangles += static_cast<double>(q.triangles);
+    vertices += static_cast<double>(q.vertices);
+    below_20 += q.share_below_20 * static_cast<double>(q.triangles);
+    min_angle = std::min(min_angle, q.min_angle);
+    invalid_frames += !(q.closed && q.manifold && q.oriented && q.self_intersecting_pairs == 0);
+    for (const Eigen::Vector3d& v : mesh.vertices) {
+      const MorphOracleResult o = oracle.evaluate(v, t);
+      max_error = std::max(max_error, o.distance());
+      uncertified += !o.certified;
+    }
+  }
+};
+
+struct Pair {
+  std::string name;
+  std::vector<Ball> source, target;
+  std::string alignment;
+};
+
+Molecule read_side(const std::string& spec) {
+  ReadOptions read;
+  std::string path = spec;
+  if (const auto hash = spec.find('#'); hash != std::string::npos) {
+    path = spec.substr(0, hash);
+    read.model = std::atoi(spec.c_str() + hash + 1);
+  }
+  return read_molecule(path, read);
+}
+
+Pair load_pair(const std::string& spec) {
+  const auto colon = spec.find(':');
+  if (colon == std::string::npos) throw std::runtime_error("a pair is SOURCE:TARGET, got " + spec);
+  std::string target_spec = spec.substr(colon + 1);
+  const std::string source_spec = spec.substr(0, colon);
+  if (!target_spec.empty() && target_spec[0] == '#')  // "file#1:#3": the same file
+    target_spec = source_spec.substr(0, source_spec.find('#')) + target_spec;
+  const Molecule source = read_side(source_spec);
+  const Molecule target = read_side(target_spec);
+  const Alignment a = align(source, target, AlignmentMethod::automatic);
+  Pair p;
+  auto base = [](const std::string& s) { return s.substr(s.find_last_of('/') + 1); };
+  p.name = base(source_spec) + " -> " + base(target_spec);
+  p.source = balls_from_molecule(source, kShrink);
+  p.target = balls_from_molecule(moved(target, a.motion), kShrink);
+  p.alignment = alignment_method_name(a.used);
+  return p;
+}
+
+std::vector<double> frame_times(int n) {
+  std::vector<double> t;
+  for (int k = 1; k <= n; ++k) t.push_back(static_cast<double>(k) / (n + 1));
+  return t;
+}
+
+Column run_morph(const Pair& p, int frames) {
+  const MorphOracle oracle(p.source, p.target, kShrink);
+  const std::vector<double> ts = frame_times(frames);
+  Column c;
+  const auto start = Clock::now();
+  Morph morph = prepare_morph(p.source, p.target, ts.front());
+  c.seconds_first = seconds_since(start);
+  c.seconds += c.seconds_first;
+  c.grade(morph.frame().mesh, oracle, ts.front());
+  for (size_t k = 1; k < ts.size(); ++k) {
+    const MorphFrame& f = morph.advance_to(ts[k]);
+    c.seconds += f.stats.seconds;
+    c.seconds_repair += f.stats.seconds_repair;
+    c.repaired += f.stats.repaired;
+    c.full_rebuilds += f.stats.full_rebuild;
+    c.inserted += static_cast<double>(f.stats.inserted);
+    c.removed += static_cast<double>(f.stats.removed);
+    c.relocated += static_cast<double>(f.stats.relocated);
+    c.grade(f.mesh, oracle, ts[k]);
+  }
+  return c;
+}
+
+// (b): the complex of B(t) from the live pairs and the quality mesh of it.
+Column run_rebuilds(const Pair& p, int sample) {
+  const MorphOracle oracle(p.source, p.target, kShrink);
+  const std::vector<BallPair> pairs = live_pairs(p.source, p.target);
+  const MeshingOptions criteria = MorphOptions{}.frames;
+  Column c;
+  for (double t : frame_times(sample)) {
+    const auto start = Clock::now();
+    const SkinComplex complex = build_skin_complex(interpolated_balls(p.source, p.target, pairs, t), {kShrink});
+    SkinMeshResult made = mesh_skin(complex, criteria);
+    c.seconds += seconds_since(start);
+    if (made.status != MeshingStatus::ok) throw std::runtime_error(made.message);
+    c.full_rebuilds += 1;
+    c.grade(made.mesh, oracle, t);
+  }
+  return c;
+}
+
+// (a): CGAL's skin mesher on all m*n interpolated balls, jittered.
+Column run_cgal(const Pair& p, int sample) {
+  const MorphOracle oracle(p.source, p.target, kShrink);
+  const std::vector<BallPair> pairs = all_pairs(p.source.size(), p.target.size());
+  Column c;
+  for (double t : frame_times(sample)) {
+    const auto start = Clock::now();
+    const std::vector<Ball> balls = test::jittered(interpolated_balls(p.source, p.target, pairs, t));
+    const SurfaceMesh mesh = test::cgal_skin_mesh(balls, kShrink, 0);
+    c.seconds += seconds_since(start);
+    c.full_rebuilds += 1;
+    c.grade(mesh, oracle, t);
+  }
+  return c;
+}
+
+struct Row {
+  std::string pair, column;
+  bench::Forked<Column> run;
+};
+
+void print_json(const Row& r, const Pair& p) {
+  const Column& c = r.run.result;
+  const double n = std::max(1.0, c.frames);
+  std::printf(
+      "{\"pair\": \"%s\", \"source_atoms\": %zu, \"target_atoms\": %zu, \"alignment\": \"%s\", \"column\": \"%s\", "
+      "\"status\": \"%s\", \"frames\": %.0f, \"seconds_per_frame\": %.4f, \"seconds_first_frame\": %.3f, "
+      "\"seconds_repair_per_frame\": %.4f, \"peak_mb\": %.1f, \"mean_triangles\": %.0f, \"min_angle\": %.3f, "
+      "\"share_below_20\": %.6f, \"max_on_surface_error\": %.3e, \"uncertified\": %.0f, \"invalid_frames\": %.0f, "
+      "\"repaired_frames\": %.0f, \"full_rebuilds\": %.0f, \"inserted_per_frame\": %.1f, "
+      "\"removed_per_frame\": %.1f, \"relocated_per_frame\": %.1f, \"mean_vertices\": %.0f}\n",
+      r.pair.c_str(), p.source.size(), p.target.size(), p.alignment.c_str(), r.column.c_str(),
+      r.run.status.c_str(), c.frames, c.seconds / n, c.seconds_first, c.seconds_repair / n, r.run.peak_mb,
+      c.triangles / n, c.min_angle, c.below_20 / std::max(1.0, c.triangles), c.max_error, c.uncertified,
+      c.invalid_frames, c.repaired, c.full_rebuilds, c.inserted / n, c.removed / n, c.relocated / n,
+      c.vertices / n);
+  std::fflush(stdout);
+}
+
+double per_frame(const Row* r) {
+  return r && r->run.status == "ok" ? r->run.result.seconds / std::max(1.0, r->run.result.frames) : NAN;
+}
+
+void print_table(const std::vector<Row>& rows, int timeout) {
+  std::printf("\n| pair | column | frames | s/frame | peak MB | triangles | min angle | <20 deg | max error A | "
+              "invalid frames | repaired | full rebuilds |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const Row& r : rows) {
+    const Column& c = r.run.result;
+    if (r.run.status != "ok") {
+      std::printf("| %s | %s | %s (limit %d s) | | | | | | | | | |\n", r.pair.c_str(), r.column.c_str(),
+                  r.run.status.c_str(), timeout);
+      continue;
+    }
+    const double n = std::max(1.0, c.frames);
+    std::printf("| %s | %s | %.0f | %.4f | %.0f | %.0f | %.2f | %.3f%% | %.1e | %.0f | %.0f | %.0f |\n",
+                r.pair.c_str(), r.column.c_str(), c.frames, c.seconds / n, r.run.peak_mb, c.triangles / n,
+                c.min_angle, 100 * c.below_20 / std::max(1.0, c.triangles), c.max_error, c.invalid_frames,
+                c.repaired, c.full_rebuilds);
+  }
+  std::printf("\n| pair | a/c | b/c |\n|---|---|---|\n");
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].column != "c morph") continue;
+    const Row *a = nullptr, *b = nullptr;
+    for (const Row& r : rows)
+      if (r.pair == rows[i].pair) {
+        if (r.column.rfind("a ", 0) == 0) a = &r;
+        if (r.column.rfind("b ", 0) == 0) b = &r;
+      }
+    const double c = per_frame(&rows[i]);
+    std::printf("| %s | %.1f | %.1f |\n", rows[i].pair.c_str(), per_frame(a) / c, per_frame(b) / c);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int frames = 100, sample = 5, timeout = 3600;
+  bool cgal = true;
+  std::vector<std::string> specs;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--frames" && i + 1 < argc) frames = std::max(2, std::atoi(argv[++i]));
+    else if (a == "--sample" && i + 1 < argc) sample = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--timeout" && i + 1 < argc) timeout = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--skip-cgal") cgal = false;
+    else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "usage: bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [PAIR...]\n");
+      return 2;
+    } else specs.push_back(a);
+  }
+  const std::string d = SKINMESH_DATA_DIR;
+  if (specs.empty())
+    specs = {d + "/pept.pdb:" + d + "/3al1.pdb", d + "/3al1.pdb:" + d + "/1ubi.pdb", d + "/1ubi.pdb:" + d + "/1hpv.pdb",
+             d + "/2k39_3models.pdb#1:#3"};
+  std::vector<Row> rows;
+  for (const std::string& spec : specs) {
+    Pair p;
+    try {
+      p = load_pair(spec);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_morph: %s\n", e.what());
+      return 1;
+    }
+    std::vector<std::pair<std::string, std::function<Column()>>> columns;
+    if (cgal) columns.emplace_back("a CGAL skin, all m*n pairs", [&] { return run_cgal(p, sample); });
+    columns.emplace_back("b skinmesh rebuild, live pairs", [&] { return run_rebuilds(p, sample); });
+    columns.emplace_back("c morph", [&] { return run_morph(p, frames); });
+    for (const auto& [name, task] : columns) {
+      std::fprintf(stderr, "%s: %s ...\n", p.name.c_str(), name.c_str());
+      Row row{p.name, name, bench::run_forked<Column>(timeout, task)};
+      print_json(row, p);
+      rows.push_back(row);
+    }
+  }
+  print_table(rows, timeout);
+  return 0;
+}
