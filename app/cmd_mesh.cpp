@@ -32,22 +32,12 @@ struct MeshCommandOptions {
   bool no_self_intersections = false;
 };
 
-// The atom that owns a vertex: of the balls of its mixed cell, the one with the
-// smallest power distance (the atom whose region of the power diagram holds
-// the vertex's Voronoi part).
+// The patch type and the atom that owns each vertex.
 VertexAttributes attributes_of(const SkinComplex& complex, const SurfaceMesh& mesh) {
   VertexAttributes a;
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
-    const MixedCell& cell = complex.cell(mesh.cells[v]);
-    int best = cell.balls[0];
-    for (int k = 1; k <= cell.dim; ++k) {
-      const int b = cell.balls[static_cast<size_t>(k)];
-      if (complex.balls()[static_cast<size_t>(b)].power(mesh.vertices[v]) <
-          complex.balls()[static_cast<size_t>(best)].power(mesh.vertices[v]))
-        best = b;
-    }
-    a.patch.push_back(cell.dim);
-    a.atom.push_back(best);
+    a.patch.push_back(complex.cell(mesh.cells[v]).dim);
+    a.atom.push_back(complex.owning_ball(mesh.vertices[v], mesh.cells[v]));
   }
   return a;
 }

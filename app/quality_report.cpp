@@ -9,8 +9,8 @@
 
 namespace skinmesh::app {
 
-std::string json_text(const nlohmann::json& j) {
-  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+std::string json_text(const nlohmann::json& j, JsonLayout layout) {
+  return j.dump(layout == JsonLayout::indented ? 2 : -1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 nlohmann::json to_json(const MeshQuality& q) {

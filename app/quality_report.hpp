@@ -17,10 +17,11 @@
 
 namespace skinmesh::app {
 
-// JSON as text, two-space indented. Bytes that are not UTF-8 (an atom name
+// JSON as text, two-space indented or on one line. Bytes that are not UTF-8 (an atom name
 // or a file name from an old file) become U+FFFD instead of an exception
 // after the work is done.
-std::string json_text(const nlohmann::json& j);
+enum class JsonLayout { indented, one_line };  // one_line: a JSON Lines record
+std::string json_text(const nlohmann::json& j, JsonLayout layout = JsonLayout::indented);
 
 nlohmann::json to_json(const MeshQuality& q);
 

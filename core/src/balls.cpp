@@ -28,16 +28,30 @@ std::vector<Ball> balls_from_molecule(const Molecule& molecule, double shrink,
   return balls;
 }
 
+namespace {
+
+void write_comment(std::ostream& out, const std::string& comment) {
+  std::istringstream lines(comment);
+  std::string line;
+  while (std::getline(lines, line)) out << "# " << line << '\n';
+}
+
+}  // namespace
+
 void write_wpts(std::ostream& out, const std::vector<Ball>& balls, const std::string& comment) {
   out << "# skinmesh weighted points: x y z w (Angstrom, Angstrom^2); power distance |x - z|^2 - w\n";
-  if (!comment.empty()) {
-    std::istringstream lines(comment);
-    std::string line;
-    while (std::getline(lines, line)) out << "# " << line << '\n';
-  }
+  write_comment(out, comment);
   for (const Ball& b : balls)
     out << exact_number_text(b.center[0]) << ' ' << exact_number_text(b.center[1]) << ' '
         << exact_number_text(b.center[2]) << ' ' << exact_number_text(b.weight) << '\n';
+}
+
+void write_xyzr(std::ostream& out, const Molecule& molecule, const std::string& comment) {
+  out << "# skinmesh atoms: x y z r (Angstrom)\n";
+  write_comment(out, comment);
+  for (const Atom& a : molecule.atoms)
+    out << exact_number_text(a.position[0]) << ' ' << exact_number_text(a.position[1]) << ' '
+        << exact_number_text(a.position[2]) << ' ' << exact_number_text(a.radius) << '\n';
 }
 
 }  // namespace skinmesh

@@ -74,6 +74,16 @@ double SkinComplex::quadric(int c, const Eigen::Vector3d& x) const {
   return quadric_at(cell, shrink_, y, cell.P * y);
 }
 
+int SkinComplex::owning_ball(const Eigen::Vector3d& x, int cell) const {
+  const MixedCell& c = cells_[static_cast<size_t>(cell)];
+  int best = c.balls[0];
+  for (int k = 1; k <= c.dim; ++k) {
+    const int b = c.balls[static_cast<size_t>(k)];
+    if (balls_[static_cast<size_t>(b)].power(x) < balls_[static_cast<size_t>(best)].power(x)) best = b;
+  }
+  return best;
+}
+
 int SkinComplex::find_cell(std::array<int, 4> balls) const {
   const auto it = cell_of_balls_.find(ball_tuple(balls));
   return it == cell_of_balls_.end() ? -1 : it->second;

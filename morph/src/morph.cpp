@@ -140,24 +140,69 @@ bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std:
   return true;
 }
 
+// Every vertex projected onto the skin of another complex (the target's at
+// t = 1, the overlay after a first frame at t = 0), then the frame remeshed
+// from them: the cells of the two complexes are not the same cells.
+void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
+  SurfaceMesh moved = frame_.mesh;
+  std::vector<char> lost(moved.vertices.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, lost.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const Projection p = next.project(moved.vertices[v], -1, 1e-14);
+      lost[v] = !p.converged;
+      if (p.converged) {
+        moved.vertices[v] = p.point;
+        moved.cells[v] = p.cell;
+      }
+    }
+  });
+  stats.lost = std::count(lost.begin(), lost.end(), 1);
+  stats.relocated = static_cast<long>(lost.size()) - stats.lost;
+  frame_.stats = stats;
+  const auto repair_start = Clock::now();
+  if (!repair(next, moved, lost)) {
+    const long before = static_cast<long>(frame_.mesh.vertices.size());
+    rebuild(next, options_.frames);
+    frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
+    frame_.stats.removed = before;
+  }
+  frame_.stats.seconds_repair = seconds_since(repair_start);
+}
+
+void Morph::finish_frame(double t, Clock::time_point start) {
+  t_ = t;
+  frame_.stats.t = t;
+  frame_.stats.vertices = static_cast<long>(frame_.mesh.vertices.size());
+  frame_.stats.triangles = static_cast<long>(frame_.mesh.triangles.size());
+  frame_.stats.seconds = seconds_since(start);
+}
+
 const MorphFrame& Morph::advance_to(double t) {
-  if (!(t > t_ && t < 1)) contract_error("advance_to: t must lie after the current frame and below 1");
+  if (!(t > t_ && t <= 1)) contract_error("advance_to: t must lie after the current frame and at most 1");
   const auto start = Clock::now();
-  const SkinComplex next = middle_.with_balls(interpolated_balls(source_, target_, pairs_, t));
   FrameStats stats;
   stats.t = t;
   stats.events = std::count_if(events_.begin(), events_.end(),
                                [&](const TopologyEvent& e) { return e.t > t_ && e.t <= t; });
+  if (t == 1.0 || !on_overlay_) {
+    SkinComplex next = t == 1.0 ? build_skin_complex(target_, {options_.shrink})
+                                : middle_.with_balls(interpolated_balls(source_, target_, pairs_, t));
+    reseat(next, stats);
+    current_ = std::move(next);
+    on_overlay_ = t < 1.0;
+    finish_frame(t, start);
+    return frame_;
+  }
+  const SkinComplex next = middle_.with_balls(interpolated_balls(source_, target_, pairs_, t));
   SurfaceMesh moved = frame_.mesh;
   std::vector<char> drop = move_vertices(next, moved, stats);
   if (stats.lost == 0) stats.bad_triangles = count_bad_triangles(next, moved);
-  stats.crowded = mark_crowded(next, moved, drop);
-  t_ = t;
   frame_.stats = stats;
-  if (stats.events == 0 && stats.lost == 0 && stats.crowded == 0 && stats.bad_triangles == 0) {
+  if (stats.events == 0 && stats.lost == 0 && stats.bad_triangles == 0) {
     frame_.mesh = std::move(moved);  // ids stay: every vertex survives
   } else {
     const auto repair_start = Clock::now();
+    frame_.stats.crowded = mark_crowded(next, moved, drop);
     if (!repair(next, moved, drop)) {
       const long before = static_cast<long>(frame_.mesh.vertices.size());
       rebuild(next, options_.frames);
@@ -167,24 +212,37 @@ const MorphFrame& Morph::advance_to(double t) {
     frame_.stats.seconds_repair = seconds_since(repair_start);
   }
   current_ = next;
-  frame_.stats.t = t;
-  frame_.stats.vertices = static_cast<long>(frame_.mesh.vertices.size());
-  frame_.stats.triangles = static_cast<long>(frame_.mesh.triangles.size());
-  frame_.stats.seconds = seconds_since(start);
+  finish_frame(t, start);
   return frame_;
 }
 
+std::vector<std::array<int, 2>> Morph::vertex_atoms() const {
+  const SurfaceMesh& mesh = frame_.mesh;
+  std::vector<std::array<int, 2>> atoms(mesh.vertices.size());
+  for (size_t v = 0; v < atoms.size(); ++v) {
+    const int ball = current_.owning_ball(mesh.vertices[v], mesh.cells[v]);
+    if (on_overlay_) atoms[v] = {pairs_[static_cast<size_t>(ball)].source, pairs_[static_cast<size_t>(ball)].target};
+    else if (t_ == 0.0) atoms[v] = {ball, -1};
+    else atoms[v] = {-1, ball};
+  }
+  return atoms;
+}
+
 Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0, const MorphOptions& options) {
-  if (!(t0 > 0 && t0 < 1)) contract_error("prepare_morph: the first frame must lie in (0,1)");
+  if (!(t0 >= 0 && t0 < 1)) contract_error("prepare_morph: the first frame must lie in [0,1)");
+  if (source.empty() || target.empty()) contract_error("prepare_morph: both ball sets must be non-empty");
   std::vector<BallPair> pairs = live_pairs(source, target);
   SkinComplex middle = build_skin_complex(interpolated_balls(source, target, pairs, 0.5), {options.shrink});
   Morph morph(std::move(source), std::move(target), std::move(pairs), std::move(middle), options);
-  morph.current_ = morph.middle_.with_balls(interpolated_balls(morph.source_, morph.target_, morph.pairs_, t0));
+  const auto start = Clock::now();
+  morph.on_overlay_ = t0 > 0;
+  morph.current_ = t0 > 0
+                       ? morph.middle_.with_balls(interpolated_balls(morph.source_, morph.target_, morph.pairs_, t0))
+                       : build_skin_complex(morph.source_, {options.shrink});
   morph.t_ = t0;
   morph.rebuild(morph.current_, options.first);
-  morph.frame_.stats.t = t0;
-  morph.frame_.stats.vertices = static_cast<long>(morph.frame_.mesh.vertices.size());
-  morph.frame_.stats.triangles = static_cast<long>(morph.frame_.mesh.triangles.size());
+  morph.frame_.stats.inserted = static_cast<long>(morph.frame_.mesh.vertices.size());
+  morph.finish_frame(t0, start);
   return morph;
 }
 

@@ -20,7 +20,12 @@ Eigen::Vector3d normal_of(const SurfaceMesh& mesh, size_t v) {
 }
 
 bool has(const VertexAttributes* a, const SurfaceMesh& mesh) {
-  return a && a->patch.size() == mesh.vertices.size() && a->atom.size() == mesh.vertices.size();
+  if (!a) return false;
+  if (a->patch.size() != mesh.vertices.size() || a->atom.size() != mesh.vertices.size()) return false;
+  for (const auto& column : a->more)
+    if (column.second.size() != mesh.vertices.size())
+      contract_error("vertex property " + column.first + ": one value per vertex expected");
+  return true;
 }
 
 template <class T>
@@ -43,7 +48,10 @@ void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
   for (const char* c : {"x", "y", "z"}) out << "property " << real << " " << c << "\n";
   if (normals)
     for (const char* c : {"nx", "ny", "nz"}) out << "property " << real << " " << c << "\n";
-  if (attrs) out << "property uchar patch\nproperty int atom\n";
+  if (attrs) {
+    out << "property uchar patch\nproperty int atom\n";
+    for (const auto& column : attributes->more) out << "property int " << column.first << "\n";
+  }
   out << "element face " << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
   auto real_out = [&](double v) {
     if (options.single_precision)
@@ -58,6 +66,7 @@ void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
     if (attrs) {
       put(out, static_cast<uint8_t>(attributes->patch[v]));
       put(out, static_cast<int32_t>(attributes->atom[v]));
+      for (const auto& column : attributes->more) put(out, static_cast<int32_t>(column.second[v]));
     }
   }
   for (const auto& t : mesh.triangles) {
@@ -126,8 +135,10 @@ void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
     out << "</DataArray>\n";
   }
   if (has(attributes, mesh)) {
-    for (const auto& [name, values] : {std::pair<const char*, const std::vector<int>*>{"patch", &attributes->patch},
-                                       {"atom", &attributes->atom}}) {
+    std::vector<std::pair<std::string, const std::vector<int>*>> columns{{"patch", &attributes->patch},
+                                                                         {"atom", &attributes->atom}};
+    for (const auto& column : attributes->more) columns.emplace_back(column.first, &column.second);
+    for (const auto& [name, values] : columns) {
       out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
       for (int v : *values) out << v << "\n";
       out << "</DataArray>\n";

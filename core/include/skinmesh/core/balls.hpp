@@ -34,5 +34,8 @@ std::vector<Ball> balls_from_molecule(const Molecule& molecule, double shrink,
 // weight w in Angstrom^2 (negative allowed), '#' comments; written with 17
 // significant digits so that reading it back gives the same doubles.
 void write_wpts(std::ostream& out, const std::vector<Ball>& balls, const std::string& comment = "");
+// The atoms as XYZR at full precision (%.17g): reading the file back gives
+// the same balls bit for bit.
+void write_xyzr(std::ostream& out, const Molecule& molecule, const std::string& comment = "");
 
 }  // namespace skinmesh

@@ -87,6 +87,10 @@ class SkinComplex {
   // cell's index, or -1 when X is no simplex of this complex.
   int find_cell(std::array<int, 4> balls) const;
 
+  // The ball a point of `cell` belongs to: of the cell's balls, the one of
+  // least power distance to x (its region of the power diagram holds x).
+  int owning_ball(const Eigen::Vector3d& x, int cell) const;
+
   // Faces of a cell (X minus one ball; the i-th drops balls[i]) and cofaces
   // (X plus one ball), each with the ball whose power bounds nu_X. Where a
   // coface is flat (MixedCell::degenerate), the cells beyond its flat cluster

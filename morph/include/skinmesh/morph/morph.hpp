@@ -6,22 +6,24 @@
 // mesher's own criteria (restricted_triangle, triangle_defect).
 //
 // Repair: a frame where a triangle fails, a vertex is lost (its cell's size
-// vanished and no skin point is near), transport crowded vertices, or a
-// critical topology event lies since the last frame, is remeshed from its
-// own transported vertices (remesh_skin): they are kept, crowded ones
-// removed, and restricted Delaunay refinement inserts points only where a
-// triangle fails, and seeds only on skin the vertices miss (a component
-// born, a neck opened). Only when that fails is the frame meshed from
+// vanished and no skin point is near), or a critical topology event lies
+// since the last frame, is remeshed from its own transported vertices
+// (remesh_skin): they are kept, those transport crowded together removed,
+// and restricted Delaunay refinement inserts points only where a triangle
+// fails, and seeds only on skin the vertices miss (a component born, a neck
+// opened). Only when that fails is the frame meshed from
 // scratch (FrameStats::full_rebuild). Every frame is a correct quality mesh
 // of the skin of B(t) either way.
 #pragma once
 
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/morph/events.hpp"
 
+#include <array>
 #include <vector>
 
 namespace skinmesh {
@@ -36,10 +38,12 @@ struct MorphOptions {
     o.min_angle = 20.0;     // degrees
     return o;
   }();
-  // A transported vertex nearer than this times the target edge length to
-  // a neighbour along a mesh edge is removed at the next repair (transport
-  // crowds vertices where a patch shrinks); it also triggers a repair.
-  double crowded_below = 0.2;
+  // At a repair, a transported vertex nearer than this times the target
+  // edge length to a neighbour along a mesh edge is removed (transport
+  // crowds vertices where a patch shrinks; refinement puts back what the
+  // criteria need). Measured on 2k39 model 1 -> 3 in 10 steps: 0.2 let the
+  // vertex count double by t = 0.6, 0.4 kept it within 3,000-4,300.
+  double crowded_below = 0.4;
 };
 
 struct FrameStats {
@@ -48,7 +52,7 @@ struct FrameStats {
   long moved = 0;              // transported inside their cell (exactly onto the new skin)
   long relocated = 0;          // left their cell (or its size vanished) and were projected onto the new skin
   long bad_triangles = 0;      // failing the frame's criteria after the move
-  long crowded = 0;            // vertices removed because transport crowded them
+  long crowded = 0;            // vertices removed at the repair because transport crowded them
   long lost = 0;               // vertices that could not be put on the new skin (removed)
   long events = 0;             // critical topology events since the previous frame
   bool repaired = false;       // the frame was remeshed from its transported vertices
@@ -68,9 +72,19 @@ struct MorphFrame {
 
 class Morph {
  public:
-  // Moves the mesh to frame t, later than the current one and below 1.
-  // Throws ContractError otherwise.
+  // Moves the mesh to frame t, later than the current one and at most 1.
+  // Throws ContractError otherwise. Inside (0,1) the vertices are
+  // transported in the overlay complex; at t = 1 (and from a first frame at
+  // t = 0) the overlay degenerates to the target's (source's) complex, so the
+  // vertices are projected onto the other complex's skin and the frame is
+  // remeshed from them.
   const MorphFrame& advance_to(double t);
+  double t() const { return t_; }
+  // Per vertex of the current frame: the source atom and the target atom it
+  // belongs to (the pair of the cell's ball of least power distance, the
+  // paper's surface point correspondence). At t = 0 and t = 1 the frame's
+  // complex is one side's own: the other side's atom is -1 there.
+  std::vector<std::array<int, 2>> vertex_atoms() const;
   const MorphFrame& frame() const { return frame_; }
   const SkinComplex& complex() const { return current_; }
   const std::vector<TopologyEvent>& events() const { return events_; }
@@ -87,9 +101,13 @@ class Morph {
   long count_bad_triangles(const SkinComplex& next, const SurfaceMesh& mesh) const;
   long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
 
+  void reseat(const SkinComplex& next, FrameStats& stats);
+  void finish_frame(double t, Clock::time_point start);
+
   std::vector<Ball> source_, target_;
   std::vector<BallPair> pairs_;
   SkinComplex middle_, current_;
+  bool on_overlay_ = true;  // current_ is the overlay complex (cells numbered as middle_)
   MorphOptions options_;
   std::vector<TopologyEvent> events_;
   MorphFrame frame_;
@@ -98,10 +116,10 @@ class Morph {
 };
 
 // Live pairs, the complex of B(1/2), the topology events, and the first
-// frame at t0 in (0,1) meshed by the mesher. The balls should be aligned
-// already (alignment.hpp). Throws ContractError for t0 outside (0,1) or
-// empty ball sets; a first frame the mesher cannot make throws Error with its
-// message.
+// frame at t0 in [0,1) meshed by the mesher (at t0 = 0: the source's own
+// skin). The balls should be aligned already (alignment.hpp). Throws
+// ContractError for t0 outside [0,1) or empty ball sets; a first frame the
+// mesher cannot make throws Error with its message.
 Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0, const MorphOptions& options = {});
 
 }  // namespace skinmesh

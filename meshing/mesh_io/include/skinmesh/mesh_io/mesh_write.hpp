@@ -8,6 +8,7 @@
 
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace skinmesh {
@@ -26,6 +27,9 @@ const char* mesh_format_name(MeshFormat format);
 struct VertexAttributes {
   std::vector<int> patch;
   std::vector<int> atom;
+  // Further integer properties by name, one value per vertex (a morph frame's
+  // id, source_atom, target_atom); PLY and VTP only.
+  std::vector<std::pair<std::string, std::vector<int>>> more;
 };
 
 struct MeshWriteOptions {

@@ -1,0 +1,400 @@
+// skinmesh morph: the quality mesh of a source molecule carried frame by
+// frame onto the skins of B(t) up to the target (morph/morph.hpp; the
+// mathematics in docs/math.md section 4), every frame checked before anything
+// is written, into a self-describing directory (docs/morph.md).
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "molecule_options.hpp"
+#include "output_file.hpp"
+#include "quality_report.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/number_text.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/mesh_io/mesh_write.hpp"
+#include "skinmesh/morph/alignment.hpp"
+#include "skinmesh/morph/morph.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+namespace skinmesh::app {
+namespace {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+struct MorphCommandOptions {
+  MoleculeOptions molecule;  // settings shared by both sides (its --model is not used)
+  std::string source, target, directory;
+  int source_model = 1, target_model = 1;
+  int frames = 21;
+  std::vector<double> times;  // instead of --frames
+  std::string align = "auto";
+  std::vector<std::string> formats{"ply", "vtp"};
+  MorphOptions morph;
+  bool no_self_intersections = false;
+};
+
+void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
+  cmd.add_option("source", o.source, "source molecule (any format a molecule is read from)")->required();
+  cmd.add_option("target", o.target, "target molecule")->required();
+  cmd.add_option("--output,-o", o.directory, "output directory (made if missing; must hold no frames already)")
+      ->required();
+  cmd.add_option("--frames", o.frames, "frames at t = 0, 1/(N-1), ..., 1")
+      ->check(finite_number())->check(CLI::Range(2, 100000))->capture_default_str();
+  cmd.add_option("--t", o.times, "frame times in [0, 1] instead of --frames (comma-separated, increasing)")
+      ->delimiter(',')->check(finite_number())->check(CLI::Range(0.0, 1.0));
+  cmd.add_option("--source-model", o.source_model, "1-based model of the source file")
+      ->check(finite_number())->check(CLI::PositiveNumber);
+  cmd.add_option("--target-model", o.target_model, "1-based model of the target file")
+      ->check(finite_number())->check(CLI::PositiveNumber);
+  cmd.add_option("--align", o.align,
+                 "auto (Kabsch on matched atoms when both sides are the same molecule, centroid otherwise), "
+                 "none, centroid or kabsch")
+      ->check(CLI::IsMember({"auto", "none", "centroid", "kabsch"}))->capture_default_str();
+  cmd.add_option("--min-angle", o.morph.frames.min_angle, "smallest angle of every triangle of every frame, degrees")
+      ->check(finite_number())->check(CLI::Range(1.0, 30.0))->capture_default_str();
+  cmd.add_option("--epsilon", o.morph.first.sizing.epsilon, "curvature-relative size (edge / radius of curvature)")
+      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+  cmd.add_option("--edge-length", o.morph.first.edge_length, "largest edge length in Angstrom (0: curvature only)")
+      ->check(finite_number())->check(CLI::NonNegativeNumber);
+  cmd.add_option("--tolerance", o.morph.first.tolerance, "largest circumcentre distance from the skin, A")
+      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+  cmd.add_option("--max-triangles", o.morph.first.max_triangles, "stop with an error past this many triangles")
+      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+  cmd.add_option("--threads", o.morph.first.threads, "threads (0: all)")
+      ->check(finite_number())->check(CLI::NonNegativeNumber);
+  cmd.add_option("--format", o.formats, "mesh formats per frame, comma-separated: ply vtp off obj stl "
+                                        "(frames.pvd needs vtp)")
+      ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl"}))->capture_default_str();
+  cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
+  add_molecule_settings(cmd, o.molecule);
+}
+
+// The frame times asked for: increasing, in [0, 1].
+std::vector<double> frame_times(const MorphCommandOptions& o) {
+  std::vector<double> t = o.times;
+  if (t.empty())
+    for (int k = 0; k < o.frames; ++k) t.push_back(k == o.frames - 1 ? 1.0 : static_cast<double>(k) / (o.frames - 1));
+  for (size_t k = 1; k < t.size(); ++k)
+    if (!(t[k] > t[k - 1])) contract_error("--t: frame times must increase");
+  if (t.back() == 0.0) contract_error("--t: at least one frame after t = 0 is needed");
+  return t;
+}
+
+// The morph's frame criteria follow from the command's options: the first
+// frame at the mesher's 30 degrees (room for transport), later frames at
+// --min-angle, both with the sizing asked for.
+MorphOptions morph_options(const MorphCommandOptions& o) {
+  MorphOptions m = o.morph;
+  m.shrink = o.molecule.shrink;
+  const double angle = m.frames.min_angle;
+  m.frames = m.first;
+  m.frames.min_angle = angle;
+  m.first.min_angle = std::max(30.0, angle);
+  return m;
+}
+
+struct Sides {
+  Molecule source, target;  // the target moved into the source's frame
+  Alignment alignment;
+  std::vector<Ball> source_balls, target_balls;
+};
+
+Sides read_sides(const MorphCommandOptions& o) {
+  Sides s;
+  ReadOptions read = o.molecule.read;
+  read.model = o.source_model;
+  s.source = read_molecule(o.source, read);
+  read.model = o.target_model;
+  s.target = read_molecule(o.target, read);
+  if (s.source.atoms.empty()) input_error(o.source, 0, "no atoms left to mesh");
+  if (s.target.atoms.empty()) input_error(o.target, 0, "no atoms left to mesh");
+  const std::map<std::string, AlignmentMethod> methods{{"auto", AlignmentMethod::automatic},
+                                                       {"none", AlignmentMethod::none},
+                                                       {"centroid", AlignmentMethod::centroid},
+                                                       {"kabsch", AlignmentMethod::kabsch}};
+  s.alignment = align(s.source, s.target, methods.at(o.align));
+  s.target = moved(std::move(s.target), s.alignment.motion);
+  s.source_balls = balls_from_molecule(s.source, o.molecule.shrink, o.molecule.convention());
+  s.target_balls = balls_from_molecule(s.target, o.molecule.shrink, o.molecule.convention());
+  return s;
+}
+
+// What is measured of each frame before it is written.
+struct FrameCheck {
+  MeshQuality quality;
+  double max_error = 0;   // morph oracle distance of the vertices, Angstrom
+  long uncertified = 0;
+  double share_below_bound = 0;  // of the triangles, those whose smallest angle is under the bound
+  bool holds = false;
+};
+
+double share_below(const SurfaceMesh& mesh, double bound_degrees) {
+  long below = 0;
+  for (const auto& t : mesh.triangles) {
+    double smallest = 180;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& p = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>(k)])];
+      const Eigen::Vector3d u = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)])] - p;
+      const Eigen::Vector3d w = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 2) % 3)])] - p;
+      smallest = std::min(smallest, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / M_PI);
+    }
+    below += smallest < bound_degrees;
+  }
+  return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
+}
+
+FrameCheck check_frame(const SurfaceMesh& mesh, const MorphOracle& oracle, double t, double min_angle,
+                       bool self_intersections) {
+  FrameCheck c;
+  GradeOptions grade;
+  grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
+  c.quality = grade_mesh(mesh, grade);
+  using Worst = std::pair<double, long>;
+  const Worst worst = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, mesh.vertices.size(), 256), Worst{0.0, 0},
+      [&](const tbb::blocked_range<size_t>& r, Worst w) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+          const MorphOracleResult e = oracle.evaluate(mesh.vertices[v], t);
+          w.first = std::max(w.first, e.distance());
+          w.second += !e.certified;
+        }
+        return w;
+      },
+      [](Worst a, Worst b) { return Worst{std::max(a.first, b.first), a.second + b.second}; });
+  c.max_error = worst.first;
+  c.uncertified = worst.second;
+  c.share_below_bound = share_below(mesh, min_angle);
+  const MeshQuality& q = c.quality;
+  c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
+            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
+            c.uncertified == 0;
+  return c;
+}
+
+json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
+  const MeshQuality& q = c.quality;
+  return {{"t", s.t},
+          {"file", file},
+          {"vertices", s.vertices},
+          {"triangles", s.triangles},
+          {"min_angle", q.min_angle},
+          {"share_below_bound", c.share_below_bound},
+          {"moved", s.moved},
+          {"relocated", s.relocated},
+          {"inserted", s.inserted},
+          {"removed", s.removed},
+          {"repairs", s.repairs},
+          {"bad_triangles_after_transport", s.bad_triangles},
+          {"repaired", s.repaired},
+          {"full_rebuild", s.full_rebuild},
+          {"events", s.events},
+          {"max_onsurf_error", c.max_error},
+          {"components", q.components},
+          {"euler", q.euler},
+          {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
+          {"seconds", s.seconds},
+          {"seconds_repair", s.seconds_repair}};
+}
+
+// The output directory: made when missing (and removed again when the
+// command fails before anything is in it).
+class OutputDirectory {
+ public:
+  explicit OutputDirectory(const std::string& path) : path_(path) {
+    std::error_code error;
+    if (fs::exists(path_, error)) {
+      if (!fs::is_directory(path_, error)) output_error(path, "exists and is not a directory");
+    } else {
+      made_ = fs::create_directory(path_, error);
+      if (!made_) output_error(path, "cannot make the output directory (" + error.message() + ")");
+    }
+  }
+  ~OutputDirectory() {
+    std::error_code error;
+    if (made_ && !kept_ && fs::is_empty(path_, error)) fs::remove(path_, error);
+  }
+  void keep() { kept_ = true; }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+  bool made_ = false, kept_ = false;
+};
+
+std::string frame_name(size_t k, const std::string& format) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame_%04zu.%s", k, format.c_str());
+  return name;
+}
+
+// The frame's mesh in every format asked for, with per-vertex patch, id and
+// the source and target atoms (the column "atom" repeats the source atom).
+void stage_frame(OutputSet& outputs, const OutputDirectory& dir, size_t k, const Morph& morph,
+                 const std::vector<std::string>& formats) {
+  const MorphFrame& f = morph.frame();
+  VertexAttributes a;
+  std::vector<int> ids, source_atoms, target_atoms;
+  const std::vector<std::array<int, 2>> atoms = morph.vertex_atoms();
+  for (size_t v = 0; v < f.mesh.vertices.size(); ++v) {
+    a.patch.push_back(morph.complex().cell(f.mesh.cells[v]).dim);
+    a.atom.push_back(atoms[v][0]);
+    ids.push_back(static_cast<int>(f.ids[v]));
+    source_atoms.push_back(atoms[v][0]);
+    target_atoms.push_back(atoms[v][1]);
+  }
+  a.more = {{"id", ids}, {"source_atom", source_atoms}, {"target_atom", target_atoms}};
+  for (const std::string& format : formats) {
+    const MeshFormat mf = mesh_format_from_path(frame_name(k, format));
+    outputs.add(dir.file(frame_name(k, format)), [&](std::ostream& out) { write_mesh(out, f.mesh, mf, &a); });
+  }
+}
+
+// A VTK collection: ParaView opens it as an animation over t.
+void write_pvd(std::ostream& out, const std::vector<double>& times) {
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+  for (size_t k = 0; k < times.size(); ++k)
+    out << "<DataSet timestep=\"" << exact_number_text(times[k]) << "\" file=\"" << frame_name(k, "vtp")
+        << "\"/>\n";
+  out << "</Collection>\n</VTKFile>\n";
+}
+
+json alignment_json(const Alignment& a) {
+  json rotation = json::array();
+  for (int r = 0; r < 3; ++r)
+    rotation.push_back({a.motion.rotation(r, 0), a.motion.rotation(r, 1), a.motion.rotation(r, 2)});
+  return {{"method", alignment_method_name(a.used)},
+          {"matched_atoms", a.matched},
+          {"rmsd", a.rmsd},
+          {"rotation", rotation},
+          {"translation", {a.motion.translation[0], a.motion.translation[1], a.motion.translation[2]}},
+          {"maps", "target coordinates into the source's frame: x' = rotation x + translation"}};
+}
+
+// source.xyzr / target.xyzr (or .wpts when that side was read as weighted
+// points): exactly the balls used, after alignment.
+std::string stage_side(OutputSet& outputs, const OutputDirectory& dir, const std::string& side, const Molecule& m,
+                       const std::vector<Ball>& balls) {
+  const bool weighted = m.format == MoleculeFormat::Wpts;
+  const std::string name = side + (weighted ? ".wpts" : ".xyzr");
+  const std::string comment = side + " " + m.source + " (model " + std::to_string(m.model) + "), after alignment";
+  outputs.add(dir.file(name), [&](std::ostream& out) {
+    if (weighted) write_wpts(out, balls, comment);
+    else write_xyzr(out, m, comment);
+  });
+  return name;
+}
+
+// One line on the terminal, rewritten: frames done, vertices, repairs and
+// the time left at the pace so far.
+void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed) {
+  const double left = done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0.0;
+  std::fprintf(stderr, "\rskinmesh: frame %zu/%zu  t = %.4f  %ld vertices  %ld repairs  %.0f s left   ", done, total,
+               s.t, s.vertices, repairs, left);
+  std::fflush(stderr);
+}
+
+json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& morph, const std::vector<double>& t,
+                const MorphOptions& options) {
+  json events = json::array();
+  for (const TopologyEvent& e : morph.events()) events.push_back({{"t", e.t}, {"cell", e.cell}});
+  return {{"source", o.source},
+          {"target", o.target},
+          {"source_model", o.source_model},
+          {"target_model", o.target_model},
+          {"source_atoms", sides.source_balls.size()},
+          {"target_atoms", sides.target_balls.size()},
+          {"shrink", o.molecule.shrink},
+          {"weights", convention_name(o.molecule.convention())},
+          {"ball_sets", "B(t) = {(1-t) a_i + t b_j}, weight (1-t) w_i + t w_j - t(1-t)|z_i - z_j|^2 "
+                        "(docs/math.md section 4); live pairs " + std::to_string(morph.pairs().size())},
+          {"alignment", alignment_json(sides.alignment)},
+          {"frame_times", t},
+          {"topology_events", events},
+          {"min_angle", options.frames.min_angle},
+          {"first_frame_min_angle", options.first.min_angle}};
+}
+
+ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
+  const bool progress = !global.quiet && !global.json;
+  const auto start = Clock::now();
+  const std::vector<double> times = frame_times(o);
+  const MorphOptions options = morph_options(o);
+  const Sides sides = read_sides(o);
+  if (progress)
+    std::cerr << "skinmesh: alignment " << alignment_method_name(sides.alignment.used)
+              << (sides.alignment.used == AlignmentMethod::kabsch
+                      ? " on " + std::to_string(sides.alignment.matched) + " matched atoms, RMSD " +
+                            std::to_string(sides.alignment.rmsd) + " A"
+                      : std::string())
+              << "\n";
+  OutputDirectory dir(o.directory);
+  OutputSet outputs;
+  const MorphOracle oracle(sides.source_balls, sides.target_balls, o.molecule.shrink);
+  Morph morph = prepare_morph(sides.source_balls, sides.target_balls, times.front(), options);
+  std::ostringstream lines;
+  long repairs = 0, rebuilds = 0, repaired = 0;
+  for (size_t k = 0; k < times.size(); ++k) {
+    const MorphFrame& f = k == 0 ? morph.frame() : morph.advance_to(times[k]);
+    const FrameCheck check = check_frame(f.mesh, oracle, times[k], options.frames.min_angle, !o.no_self_intersections);
+    json line = frame_json(f.stats, check, frame_name(k, o.formats.front()));
+    if (!check.holds) {
+      if (progress) std::cerr << "\n";
+      std::cerr << "skinmesh: error: frame " << k << " (t = " << times[k] << ") fails a guarantee; nothing written\n"
+                << json_text(line) << "\n";
+      return ExitCode::not_met;
+    }
+    stage_frame(outputs, dir, k, morph, o.formats);
+    lines << json_text(line, JsonLayout::one_line) << "\n";
+    repairs += f.stats.repairs;
+    rebuilds += k > 0 && f.stats.full_rebuild;
+    repaired += f.stats.repaired;
+    if (progress) print_progress(k + 1, times.size(), f.stats, repairs, seconds_since(start));
+  }
+  if (progress) std::cerr << "\n";
+  json report = morph_json(o, sides, morph, times, options);
+  report["source_balls_file"] = stage_side(outputs, dir, "source", sides.source, sides.source_balls);
+  report["target_balls_file"] = stage_side(outputs, dir, "target", sides.target, sides.target_balls);
+  const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
+  if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, times); });
+  report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
+  report["frames"] = times.size();
+  report["repaired_frames"] = repaired;
+  report["full_rebuilds"] = rebuilds;
+  report["repairs"] = repairs;
+  report["seconds"] = seconds_since(start);
+  outputs.add(dir.file("frames.jsonl"), [&](std::ostream& out) { out << lines.str(); });
+  outputs.add(dir.file("morph.json"), [&](std::ostream& out) { out << json_text(report) << "\n"; });
+  outputs.commit();
+  dir.keep();
+  if (global.json) std::cout << json_text(report) << "\n";
+  else if (!global.quiet)
+    std::cout << o.directory << ": " << times.size() << " frames (" << repaired << " repaired, " << rebuilds
+              << " rebuilt from scratch), alignment " << alignment_method_name(sides.alignment.used) << ", "
+              << morph.events().size() << " topology events, " << report["seconds"].get<double>() << " s\n";
+  return ExitCode::ok;
+}
+
+}  // namespace
+
+void add_morph_command(CLI::App& app, const GlobalOptions& global, int& exit_code) {
+  add_command(app, "morph", "quality meshes of every frame of a morph from one molecule to another", global,
+              exit_code, add_morph_options, run_morph);
+}
+
+}  // namespace skinmesh::app
