@@ -13,7 +13,8 @@
 // angles) and every vertex measured by the morph oracle (docs/math.md
 // section 4), which knows neither the complex nor the live pairs.
 //
-//   bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [PAIR...]
+//   bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [--only TEXT] [PAIR...]
+//   (--only: run the columns whose name contains TEXT)
 //   PAIR: SOURCE:TARGET, a file optionally followed by #MODEL
 //   (default: pept:3al1, 3al1:1ubi, 1ubi:1hpv, 2k39_3models#1:#3 from data/)
 #include "cgal_reference.hpp"
@@ -45,7 +46,7 @@ struct Column {
   double triangles = 0, below_20 = 0, min_angle = 180;
   double max_error = 0, uncertified = 0;
   double invalid_frames = 0;  // not closed, manifold and oriented, or self-intersecting
-  double repaired = 0, full_rebuilds = 0, inserted = 0, removed = 0, relocated = 0, vertices = 0;
+  double repaired = 0, remeshed = 0, full_rebuilds = 0, inserted = 0, removed = 0, relocated = 0, vertices = 0;
 
   void grade(const SurfaceMesh& mesh, const MorphOracle& oracle, double t) {
     const MeshQuality q = grade_mesh(mesh);
@@ -104,12 +105,14 @@ std::vector<double> frame_times(int n) {
   return t;
 }
 
-Column run_morph(const Pair& p, int frames) {
+Column run_morph(const Pair& p, int frames, bool local_repair) {
   const MorphOracle oracle(p.source, p.target, kShrink);
   const std::vector<double> ts = frame_times(frames);
   Column c;
   const auto start = Clock::now();
-  Morph morph = prepare_morph(p.source, p.target, ts.front());
+  MorphOptions options;
+  if (!local_repair) options.local_repair_share = 0;
+  Morph morph = prepare_morph(p.source, p.target, ts.front(), options);
   c.seconds_first = seconds_since(start);
   c.seconds += c.seconds_first;
   c.grade(morph.frame().mesh, oracle, ts.front());
@@ -118,6 +121,7 @@ Column run_morph(const Pair& p, int frames) {
     c.seconds += f.stats.seconds;
     c.seconds_repair += f.stats.seconds_repair;
     c.repaired += f.stats.repaired;
+    c.remeshed += f.stats.remeshed;
     c.full_rebuilds += f.stats.full_rebuild;
     c.inserted += static_cast<double>(f.stats.inserted);
     c.removed += static_cast<double>(f.stats.removed);
@@ -174,12 +178,12 @@ void print_json(const Row& r, const Pair& p) {
       "\"status\": \"%s\", \"frames\": %.0f, \"seconds_per_frame\": %.4f, \"seconds_first_frame\": %.3f, "
       "\"seconds_repair_per_frame\": %.4f, \"peak_mb\": %.1f, \"mean_triangles\": %.0f, \"min_angle\": %.3f, "
       "\"share_below_20\": %.6f, \"max_on_surface_error\": %.3e, \"uncertified\": %.0f, \"invalid_frames\": %.0f, "
-      "\"repaired_frames\": %.0f, \"full_rebuilds\": %.0f, \"inserted_per_frame\": %.1f, "
+      "\"repaired_frames\": %.0f, \"remeshed_frames\": %.0f, \"full_rebuilds\": %.0f, \"inserted_per_frame\": %.1f, "
       "\"removed_per_frame\": %.1f, \"relocated_per_frame\": %.1f, \"mean_vertices\": %.0f}\n",
       r.pair.c_str(), p.source.size(), p.target.size(), p.alignment.c_str(), r.column.c_str(),
       r.run.status.c_str(), c.frames, c.seconds / n, c.seconds_first, c.seconds_repair / n, r.run.peak_mb,
       c.triangles / n, c.min_angle, c.below_20 / std::max(1.0, c.triangles), c.max_error, c.uncertified,
-      c.invalid_frames, c.repaired, c.full_rebuilds, c.inserted / n, c.removed / n, c.relocated / n,
+      c.invalid_frames, c.repaired, c.remeshed, c.full_rebuilds, c.inserted / n, c.removed / n, c.relocated / n,
       c.vertices / n);
   std::fflush(stdout);
 }
@@ -190,19 +194,19 @@ double per_frame(const Row* r) {
 
 void print_table(const std::vector<Row>& rows, int timeout) {
   std::printf("\n| pair | column | frames | s/frame | peak MB | triangles | min angle | <20 deg | max error A | "
-              "invalid frames | repaired | full rebuilds |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "invalid frames | repaired | remeshed | full rebuilds |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& r : rows) {
     const Column& c = r.run.result;
     if (r.run.status != "ok") {
-      std::printf("| %s | %s | %s (limit %d s) | | | | | | | | | |\n", r.pair.c_str(), r.column.c_str(),
+      std::printf("| %s | %s | %s (limit %d s) | | | | | | | | | | |\n", r.pair.c_str(), r.column.c_str(),
                   r.run.status.c_str(), timeout);
       continue;
     }
     const double n = std::max(1.0, c.frames);
-    std::printf("| %s | %s | %.0f | %.4f | %.0f | %.0f | %.2f | %.3f%% | %.1e | %.0f | %.0f | %.0f |\n",
+    std::printf("| %s | %s | %.0f | %.4f | %.0f | %.0f | %.2f | %.3f%% | %.1e | %.0f | %.0f | %.0f | %.0f |\n",
                 r.pair.c_str(), r.column.c_str(), c.frames, c.seconds / n, r.run.peak_mb, c.triangles / n,
                 c.min_angle, 100 * c.below_20 / std::max(1.0, c.triangles), c.max_error, c.invalid_frames,
-                c.repaired, c.full_rebuilds);
+                c.repaired, c.remeshed, c.full_rebuilds);
   }
   std::printf("\n| pair | a/c | b/c |\n|---|---|---|\n");
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -223,6 +227,7 @@ void print_table(const std::vector<Row>& rows, int timeout) {
 int main(int argc, char** argv) {
   int frames = 100, sample = 5, timeout = 3600;
   bool cgal = true;
+  std::string only;
   std::vector<std::string> specs;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -230,8 +235,10 @@ int main(int argc, char** argv) {
     else if (a == "--sample" && i + 1 < argc) sample = std::max(1, std::atoi(argv[++i]));
     else if (a == "--timeout" && i + 1 < argc) timeout = std::max(1, std::atoi(argv[++i]));
     else if (a == "--skip-cgal") cgal = false;
+    else if (a == "--only" && i + 1 < argc) only = argv[++i];
     else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "usage: bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [PAIR...]\n");
+      std::fprintf(stderr, "usage: bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [--only TEXT] "
+                           "[PAIR...]\n");
       return 2;
     } else specs.push_back(a);
   }
@@ -251,8 +258,10 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::function<Column()>>> columns;
     if (cgal) columns.emplace_back("a CGAL skin, all m*n pairs", [&] { return run_cgal(p, sample); });
     columns.emplace_back("b skinmesh rebuild, live pairs", [&] { return run_rebuilds(p, sample); });
-    columns.emplace_back("c morph", [&] { return run_morph(p, frames); });
+    columns.emplace_back("c morph", [&] { return run_morph(p, frames, true); });
+    columns.emplace_back("c' morph, whole-frame repairs only", [&] { return run_morph(p, frames, false); });
     for (const auto& [name, task] : columns) {
+      if (!only.empty() && name.find(only) == std::string::npos) continue;
       std::fprintf(stderr, "%s: %s ...\n", p.name.c_str(), name.c_str());
       Row row{p.name, name, bench::run_forked<Column>(timeout, task)};
       print_json(row, p);

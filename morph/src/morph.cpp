@@ -4,12 +4,33 @@
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/morph/transport.hpp"
 
+#include "local_repair.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 
 namespace skinmesh {
+
+namespace {
+
+MeshingOptions with_size_margin(MeshingOptions o, double margin) {
+  o.sizing.epsilon *= margin;
+  o.edge_length *= margin;
+  o.tolerance *= margin;
+  return o;
+}
+
+}  // namespace
+
+MeshingOptions MorphOptions::repair_criteria() const {
+  MeshingOptions r = with_size_margin(frames, repair_size_margin);
+  r.min_angle = std::min(30.0, frames.min_angle + repair_angle_margin);
+  return r;
+}
+
+MeshingOptions MorphOptions::first_criteria() const { return with_size_margin(first, repair_size_margin); }
 
 Morph::Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
              const MorphOptions& options)
@@ -69,23 +90,6 @@ std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mes
   return lost;
 }
 
-long Morph::count_bad_triangles(const SkinComplex& next, const SurfaceMesh& mesh) const {
-  const size_t n = mesh.triangles.size();
-  std::vector<char> bad(n, 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
-      const auto& t = mesh.triangles[i];
-      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
-                                                   mesh.vertices[static_cast<size_t>(t[1])],
-                                                   mesh.vertices[static_cast<size_t>(t[2])]};
-      const auto restricted =
-          restricted_triangle(next, corners, options_.frames.tolerance, mesh.cells[static_cast<size_t>(t[0])]);
-      bad[i] = !restricted || triangle_defect(next, *restricted, options_.frames) != TriangleDefect::none;
-    }
-  });
-  return std::count(bad.begin(), bad.end(), 1);
-}
-
 // Along every mesh edge shorter than crowded_below times the smaller target
 // length at its ends, the vertex with the larger index goes (unless its
 // partner goes already). Returns how many were marked in `drop`.
@@ -110,6 +114,30 @@ long Morph::mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::
   return marked;
 }
 
+// The failing triangles remeshed in patches (local_repair.hpp); false when
+// the seam does not hold (the caller remeshes the frame).
+bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing) {
+  detail::LocalRepairOptions local;
+  local.crowded_below = options_.crowded_below;
+  detail::LocalRepair r =
+      detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
+  if (!r.ok) return false;
+  std::vector<long> ids(r.origin.size());
+  long kept = 0;
+  for (size_t v = 0; v < ids.size(); ++v) {
+    ids[v] = r.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(r.origin[v])] : next_id_++;
+    kept += r.origin[v] >= 0;
+  }
+  frame_.stats.repaired = true;
+  frame_.stats.patch_triangles = r.patch_triangles;
+  frame_.stats.inserted = static_cast<long>(ids.size()) - kept;
+  frame_.stats.removed = static_cast<long>(moved.vertices.size()) - kept;
+  frame_.stats.repairs = r.repairs;
+  frame_.mesh = std::move(r.mesh);
+  frame_.ids = std::move(ids);
+  return true;
+}
+
 // Remeshes the frame from the transported vertices not dropped; false when
 // the mesher cannot (then the caller rebuilds from scratch).
 bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
@@ -121,7 +149,7 @@ bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std:
     samples.push_back({moved.vertices[v], moved.cells[v]});
     sample_ids.push_back(frame_.ids[v]);
   }
-  SkinMeshResult made = remesh_skin(next, samples, options_.frames);
+  SkinMeshResult made = remesh_skin(next, samples, options_.repair_criteria());
   if (made.status != MeshingStatus::ok) return false;
   std::vector<long> ids(made.mesh.vertices.size());
   long kept = 0;
@@ -132,6 +160,7 @@ bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std:
   }
   const MeshingStats& m = made.stats;
   frame_.stats.repaired = true;
+  frame_.stats.remeshed = true;
   frame_.stats.inserted = static_cast<long>(ids.size()) - kept;
   frame_.stats.removed = static_cast<long>(moved.vertices.size()) - kept;
   frame_.stats.repairs = m.inserted_size + m.inserted_shape + m.inserted_distance + m.inserted_topology;
@@ -162,7 +191,7 @@ void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
   const auto repair_start = Clock::now();
   if (!repair(next, moved, lost)) {
     const long before = static_cast<long>(frame_.mesh.vertices.size());
-    rebuild(next, options_.frames);
+    rebuild(next, options_.repair_criteria());
     frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
     frame_.stats.removed = before;
   }
@@ -196,16 +225,28 @@ const MorphFrame& Morph::advance_to(double t) {
   const SkinComplex next = middle_.with_balls(interpolated_balls(source_, target_, pairs_, t));
   SurfaceMesh moved = frame_.mesh;
   std::vector<char> drop = move_vertices(next, moved, stats);
-  if (stats.lost == 0) stats.bad_triangles = count_bad_triangles(next, moved);
+  std::vector<char> failing;
+  if (stats.lost == 0) {
+    failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+    stats.bad_triangles = std::count(failing.begin(), failing.end(), 1);
+  }
   frame_.stats = stats;
   if (stats.events == 0 && stats.lost == 0 && stats.bad_triangles == 0) {
     frame_.mesh = std::move(moved);  // ids stay: every vertex survives
   } else {
     const auto repair_start = Clock::now();
+    const bool local = stats.events == 0 && stats.lost == 0 &&
+                       stats.bad_triangles <= options_.local_repair_share * static_cast<double>(failing.size());
+    if (local && repair_locally(next, moved, failing)) {
+      frame_.stats.seconds_repair = seconds_since(repair_start);
+      current_ = next;
+      finish_frame(t, start);
+      return frame_;
+    }
     frame_.stats.crowded = mark_crowded(next, moved, drop);
     if (!repair(next, moved, drop)) {
       const long before = static_cast<long>(frame_.mesh.vertices.size());
-      rebuild(next, options_.frames);
+      rebuild(next, options_.repair_criteria());
       frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
       frame_.stats.removed = before;
     }
@@ -240,7 +281,7 @@ Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t
                        ? morph.middle_.with_balls(interpolated_balls(morph.source_, morph.target_, morph.pairs_, t0))
                        : build_skin_complex(morph.source_, {options.shrink});
   morph.t_ = t0;
-  morph.rebuild(morph.current_, options.first);
+  morph.rebuild(morph.current_, options.first_criteria());
   morph.frame_.stats.inserted = static_cast<long>(morph.frame_.mesh.vertices.size());
   morph.finish_frame(t0, start);
   return morph;

@@ -134,6 +134,7 @@ enum class Report { now, throttled };
 struct RefinementStopped {
   MeshingStatus status;
   std::string message;
+  MeshingStats stats = {};  // so far
 };
 
 class Refiner {
@@ -155,6 +156,8 @@ class Refiner {
 
   // Seeds the skin, or starts from `samples` (remesh_skin) when given.
   SkinMeshResult run(const std::vector<SkinSample>* samples = nullptr);
+  // mesh_patch: the samples with their roles, refined where patch facets fail.
+  PatchMeshResult run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles);
 
  private:
   // Calls visit(facet, key) once for every finite facet with a vertex in
@@ -172,6 +175,19 @@ class Refiner {
       }
     }
   }
+
+  // Patch mode (roles_ not empty): which facets count and which stars must
+  // be disks. Ids past the given samples are inserted points: interior.
+  bool active(int id) const {
+    return roles_.empty() || id >= static_cast<int>(roles_.size()) ||
+           roles_[static_cast<size_t>(id)] != PatchRole::context;
+  }
+  bool active(const FacetKey& ids) const { return active(ids[0]) && active(ids[1]) && active(ids[2]); }
+  bool star_checked(int id) const {
+    return roles_.empty() || id >= static_cast<int>(roles_.size()) ||
+           roles_[static_cast<size_t>(id)] == PatchRole::interior;
+  }
+  std::vector<Vertex_handle> star_checked_only(std::vector<Vertex_handle> vertices) const;
 
   FacetEval evaluate(const Facet& facet) const;
   std::optional<DualEdge> dual_edge(Cell_handle c, int i, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
@@ -219,7 +235,8 @@ class Refiner {
   double box_radius_ = 0;
   double max_radius_edge_ = 1;
   int next_id_ = 0;
-  int sample_ids_ = 0;  // ids below this are the given samples' indices (remesh_skin)
+  int sample_ids_ = 0;  // ids below this are the given samples' indices (remesh_skin, mesh_patch)
+  std::vector<PatchRole> roles_;  // by sample id (mesh_patch); empty for the whole skin
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();
 };

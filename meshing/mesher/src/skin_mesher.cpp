@@ -7,6 +7,12 @@
 #include "refiner.hpp"
 #include "skin_seeds.hpp"
 
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
+#include <CGAL/hilbert_sort.h>
+#include <CGAL/property_map.h>
+
+#include <numeric>
+
 namespace skinmesh::detail {
 
 // The Voronoi edge dual to facet i of cell c (triangle p0 p1 p2), walked
@@ -120,6 +126,9 @@ void Refiner::report(const char* stage, Report when, long pending) {
 }
 
 void Refiner::check_budget() const {
+  // A patch that needs more than twice its own points is not a local repair.
+  if (!roles_.empty() && next_id_ - sample_ids_ > 2 * sample_ids_ + 64)
+    throw RefinementStopped{MeshingStatus::stalled, "the patch needed more than twice its own points", stats_};
   // A closed surface mesh has about twice as many triangles as vertices.
   const long estimate = 2 * static_cast<long>(dt_.number_of_vertices());
   if (estimate > options_.max_triangles)
@@ -182,12 +191,15 @@ void Refiner::insert_seeds(double spacing) {
   }
 }
 
-// The given samples in one spatially sorted batch (CGAL sorts a range insert
-// along a Hilbert curve), each with its index as id; then every cell is
-// stamped as of this moment, so that the first global pass can tell later
-// changes from the batch.
+// The given samples along a Hilbert curve, each with its index as id; then
+// every cell is stamped as of this moment, so that the first global pass can
+// tell later changes from the batch. The order is fixed (CGAL's range insert
+// shuffles with its global random state): samples on one sphere are
+// cospherical, and their Delaunay triangulation, hence the mesh, depends on
+// the insertion order.
 void Refiner::insert_samples(const std::vector<SkinSample>& samples) {
-  std::vector<std::pair<K::Point_3, VertexInfo>> points;
+  std::vector<K::Point_3> points;
+  std::vector<VertexInfo> infos;
   points.reserve(samples.size());
   for (size_t i = 0; i < samples.size(); ++i) {
     Eigen::Vector3d p = samples[i].point;
@@ -201,9 +213,19 @@ void Refiner::insert_samples(const std::vector<SkinSample>& samples) {
     } else {
       cell = check.cell;
     }
-    points.push_back({K::Point_3(p[0], p[1], p[2]), VertexInfo{cell, static_cast<int>(i)}});
+    points.emplace_back(p[0], p[1], p[2]);
+    infos.push_back(VertexInfo{cell, static_cast<int>(i)});
   }
-  dt_.insert(points.begin(), points.end());
+  std::vector<size_t> order(points.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  using Traits = CGAL::Spatial_sort_traits_adapter_3<K, CGAL::Pointer_property_map<K::Point_3>::type>;
+  CGAL::hilbert_sort(order.begin(), order.end(), Traits(CGAL::make_property_map(points)));
+  Cell_handle hint;
+  for (size_t k : order) {
+    const Vertex_handle v = dt_.insert(points[k], hint);
+    if (v->info().id < 0) v->info() = infos[k];
+    hint = v->cell();
+  }
   sample_ids_ = next_id_ = static_cast<int>(samples.size());
   ++stamp_;
   for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) c->info().value = stamp_;
@@ -274,6 +296,9 @@ void Refiner::refine() {
     // would send refinement chasing it).
     const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
     if ((to_eigen(nearest->point()) - e.center).norm() < 0.5 * e.radius) continue;
+    // A patch grows no further than its context: a point nearest a context
+    // vertex would mesh skin the rest of the mesh covers already.
+    if (!active(nearest->info().id)) continue;
     switch (e.defect) {
       case TriangleDefect::topology: ++stats_.inserted_topology; break;
       case TriangleDefect::size: ++stats_.inserted_size; break;
@@ -285,6 +310,7 @@ void Refiner::refine() {
     const Vertex_handle v = insert(e.center, e.cell, c);
     if (next_id_ == before) continue;  // the point is a sample already
     for (const Facet& f : star_facets(v)) {
+      if (!roles_.empty() && !active(facet_key(f))) continue;
       const FacetEval te = evaluate(f);
       if (te.crossings > 0 && te.defect != TriangleDefect::none) queue.push(te);
     }
@@ -335,6 +361,7 @@ bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
   std::vector<Facet> facets;
   restricted->clear();
   for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) {
+    if (!roles_.empty() && !active(facet_key(*f))) continue;
     if (have_pass_cache_) {
       const Cell_handle c = f->first, n = c->neighbor(f->second);
       if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
@@ -366,7 +393,26 @@ bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
   std::vector<Vertex_handle> all;
   all.reserve(dt_.number_of_vertices());
   for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end(); ++v) all.push_back(v);
-  return repair_stars(*restricted, all);
+  return repair_stars(*restricted, star_checked_only(std::move(all)));
+}
+
+// In a patch: the interior samples, and the inserted points with no
+// context vertex among their Delaunay neighbours (near the context a star is
+// cut off by the inactive facets, as a boundary sample's is).
+std::vector<Vertex_handle> Refiner::star_checked_only(std::vector<Vertex_handle> vertices) const {
+  if (roles_.empty()) return vertices;
+  std::vector<Vertex_handle> neighbours;
+  auto checked = [&](const Vertex_handle& v) {
+    if (!star_checked(v->info().id)) return false;
+    if (v->info().id < sample_ids_) return true;
+    neighbours.clear();
+    dt_.finite_adjacent_vertices(v, std::back_inserter(neighbours));
+    return std::all_of(neighbours.begin(), neighbours.end(),
+                       [&](const Vertex_handle& w) { return active(w->info().id); });
+  };
+  vertices.erase(std::remove_if(vertices.begin(), vertices.end(), [&](const Vertex_handle& v) { return !checked(v); }),
+                 vertices.end());
+  return vertices;
 }
 
 // Checks that each of `vertices` has restricted triangles forming one disk
@@ -394,7 +440,8 @@ bool Refiner::repair_stars(const std::vector<FacetEval>& restricted, const std::
     const int id = v->info().id;
     const auto& edges = link[id];
     if (edges.empty()) {
-      isolated.push_back(v);
+      // In a patch a point without triangles is simply left out of it.
+      if (roles_.empty()) isolated.push_back(v);
       continue;
     }
     if (!is_single_cycle(edges)) {
@@ -421,6 +468,7 @@ bool Refiner::repair_stars(const std::vector<FacetEval>& restricted, const std::
       if (!p.converged || (p.point - pv).norm() < 1e-6) continue;
       const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(p.point[0], p.point[1], p.point[2]), c);
       if ((to_eigen(nearest->point()) - p.point).norm() < 1e-6) continue;
+      if (!active(nearest->info().id)) continue;  // a patch does not grow into its context
       const bool in_cell = nearest == v;
       if (!best || (in_cell && !best_in_cell) ||
           (in_cell == best_in_cell && (p.point - pv).norm() > (best->point - pv).norm())) {
@@ -488,6 +536,7 @@ void Refiner::local_passes() {
     std::vector<FacetEval> restricted;
     bool defects = false;
     for_each_facet_around(region, [&](const Facet& f, const FacetKey& key) {
+      if (!active(key)) return true;
       const Cell_handle c = f.first, n = c->neighbor(f.second);
       if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
         const auto it = pass_cache_.find(key);
@@ -503,7 +552,7 @@ void Refiner::local_passes() {
       }
       return true;
     });
-    if (defects || !repair_stars(restricted, region)) refine();
+    if (defects || !repair_stars(restricted, star_checked_only(region))) refine();
   }
 }
 
@@ -549,6 +598,39 @@ SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
   SkinMeshResult result;
   result.mesh = extract(restricted, &result.origins);
   if (!samples) result.origins.clear();
+  stats_.seconds_total = seconds_since(start);
+  result.stats = stats_;
+  return result;
+}
+
+PatchMeshResult Refiner::run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles) {
+  const auto start = Clock::now();
+  roles_ = roles;
+  insert_samples(samples);
+  std::vector<FacetEval> restricted;
+  refine_until_clean(&restricted);
+  PatchMeshResult result;
+  std::unordered_map<int, long> added;  // id of an inserted point -> its corner number
+  const long n = static_cast<long>(samples.size());
+  for (const FacetEval& e : restricted) {
+    std::array<long, 3> t;
+    for (size_t k = 0; k < 3; ++k) {
+      const Vertex_handle v = e.v[k];
+      const int id = v->info().id;
+      if (id < sample_ids_) {
+        t[k] = id;
+        continue;
+      }
+      const auto [it, fresh] = added.try_emplace(id, n + static_cast<long>(result.added.size()));
+      if (fresh) result.added.push_back({to_eigen(v->point()), complex_.evaluate(to_eigen(v->point()), v->info().cell).cell});
+      t[k] = it->second;
+    }
+    auto corner = [&](long c) -> const Eigen::Vector3d& {
+      return c < n ? samples[static_cast<size_t>(c)].point : result.added[static_cast<size_t>(c - n)].point;
+    };
+    if ((corner(t[1]) - corner(t[0])).cross(corner(t[2]) - corner(t[0])).dot(e.outward) < 0) std::swap(t[1], t[2]);
+    result.triangles.push_back(t);
+  }
   stats_.seconds_total = seconds_since(start);
   result.stats = stats_;
   return result;
@@ -619,6 +701,25 @@ SkinMeshResult mesh_skin(const SkinComplex& complex, const MeshingOptions& optio
 SkinMeshResult remesh_skin(const SkinComplex& complex, const std::vector<SkinSample>& samples,
                            const MeshingOptions& options) {
   return run_refiner(complex, &samples, options);
+}
+
+PatchMeshResult mesh_patch(const SkinComplex& complex, const std::vector<SkinSample>& samples,
+                           const std::vector<PatchRole>& roles, const MeshingOptions& options) {
+  check_options(options);
+  if (roles.size() != samples.size()) contract_error("mesh_patch: one role per sample");
+  std::optional<tbb::global_control> threads;
+  if (options.threads > 0)
+    threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
+  detail::Refiner refiner(complex, options);
+  try {
+    return refiner.run_patch(samples, roles);
+  } catch (const detail::RefinementStopped& stop) {
+    PatchMeshResult result;
+    result.status = stop.status;
+    result.message = stop.message;
+    result.stats = stop.stats;
+    return result;
+  }
 }
 
 }  // namespace skinmesh

@@ -152,4 +152,27 @@ struct SkinSample {
 SkinMeshResult remesh_skin(const SkinComplex& complex, const std::vector<SkinSample>& samples,
                            const MeshingOptions& options = {});
 
+// Local repair of one patch of a mesh (a morph frame's failing region): the
+// patch's vertices and a ring of context vertices around it are
+// triangulated; only facets whose corners are all patch vertices or inserted
+// points are judged and refined, and only interior vertices (whose whole
+// star lies in the patch) must have disk stars. The caller stitches the
+// triangles into the rest of the mesh and checks the seam.
+enum class PatchRole : char {
+  interior,  // in the patch, with its whole star
+  boundary,  // in the patch, on its rim: part of its star stays outside
+  context,   // outside the patch: shapes the Delaunay triangulation only
+};
+struct PatchMeshResult {
+  MeshingStatus status = MeshingStatus::ok;
+  std::string message;
+  std::vector<SkinSample> added;              // points refinement inserted
+  // Restricted triangles among patch vertices, outward; a corner below
+  // samples.size() is that sample, any other samples.size() + k is added[k].
+  std::vector<std::array<long, 3>> triangles;
+  MeshingStats stats;
+};
+PatchMeshResult mesh_patch(const SkinComplex& complex, const std::vector<SkinSample>& samples,
+                           const std::vector<PatchRole>& roles, const MeshingOptions& options = {});
+
 }  // namespace skinmesh

@@ -1,0 +1,345 @@
+#include "local_repair.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <functional>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+namespace skinmesh::detail {
+namespace {
+
+using Triangle = std::array<int, 3>;
+constexpr signed char kNone = -1;
+
+// The triangles around each vertex, in compressed rows.
+struct VertexStars {
+  std::vector<int> offset, triangles;
+  explicit VertexStars(const SurfaceMesh& mesh) : offset(mesh.vertices.size() + 1, 0) {
+    for (const Triangle& t : mesh.triangles)
+      for (int v : t) ++offset[static_cast<size_t>(v) + 1];
+    for (size_t v = 1; v < offset.size(); ++v) offset[v] += offset[v - 1];
+    triangles.resize(static_cast<size_t>(offset.back()));
+    std::vector<int> fill(offset.begin(), offset.end() - 1);
+    for (int f = 0; f < static_cast<int>(mesh.triangles.size()); ++f)
+      for (int v : mesh.triangles[static_cast<size_t>(f)])
+        triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = f;
+  }
+  template <class Visit>
+  void each(int v, Visit visit) const {
+    for (int k = offset[static_cast<size_t>(v)]; k < offset[static_cast<size_t>(v) + 1]; ++k)
+      visit(triangles[static_cast<size_t>(k)]);
+  }
+};
+
+// The failing triangles and every triangle within `rings` vertex-rings of them.
+std::vector<char> grow_region(const SurfaceMesh& mesh, const VertexStars& stars, std::vector<char> region, int rings) {
+  for (int r = 0; r < rings; ++r) {
+    std::vector<char> next = region;
+    for (size_t f = 0; f < region.size(); ++f)
+      if (region[f])
+        for (int v : mesh.triangles[f]) stars.each(v, [&](int g) { next[static_cast<size_t>(g)] = 1; });
+    region.swap(next);
+  }
+  return region;
+}
+
+// Per vertex: its PatchRole, or kNone. Two rings of context around the rim
+// give the patch's Delaunay triangulation the neighbours its facets have in
+// the whole frame.
+std::vector<signed char> vertex_roles(const SurfaceMesh& mesh, const VertexStars& stars,
+                                      const std::vector<char>& region) {
+  std::vector<signed char> role(mesh.vertices.size(), kNone);
+  for (size_t f = 0; f < region.size(); ++f)
+    if (region[f])
+      for (int v : mesh.triangles[f]) role[static_cast<size_t>(v)] = static_cast<signed char>(PatchRole::interior);
+  std::vector<int> rim;
+  for (int v = 0; v < static_cast<int>(role.size()); ++v) {
+    if (role[static_cast<size_t>(v)] == kNone) continue;
+    bool whole = true;
+    stars.each(v, [&](int f) { whole = whole && region[static_cast<size_t>(f)]; });
+    if (!whole) {
+      role[static_cast<size_t>(v)] = static_cast<signed char>(PatchRole::boundary);
+      rim.push_back(v);
+    }
+  }
+  for (int ring = 0; ring < 2; ++ring) {
+    std::vector<int> next;
+    for (int v : rim)
+      stars.each(v, [&](int f) {
+        for (int w : mesh.triangles[static_cast<size_t>(f)])
+          if (role[static_cast<size_t>(w)] == kNone) {
+            role[static_cast<size_t>(w)] = static_cast<signed char>(PatchRole::context);
+            next.push_back(w);
+          }
+      });
+    rim.swap(next);
+  }
+  return role;
+}
+
+// Interior vertices crowded together along a patch edge: the later one goes.
+std::vector<char> crowded_interior(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                   const std::vector<char>& region, const std::vector<signed char>& role,
+                                   const MeshingOptions& criteria, double crowded_below) {
+  std::vector<char> drop(mesh.vertices.size(), 0);
+  auto interior = [&](int v) {
+    return role[static_cast<size_t>(v)] == static_cast<signed char>(PatchRole::interior);
+  };
+  for (size_t f = 0; f < region.size(); ++f) {
+    if (!region[f]) continue;
+    const Triangle& t = mesh.triangles[f];
+    for (size_t k = 0; k < 3; ++k) {
+      const int a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
+      if (!interior(a) || !interior(b) || drop[static_cast<size_t>(a)] || drop[static_cast<size_t>(b)]) continue;
+      const auto ua = static_cast<size_t>(a), ub = static_cast<size_t>(b);
+      const double limit =
+          crowded_below * std::min(target_edge_length(complex, mesh.vertices[ua], mesh.cells[ua], criteria),
+                                   target_edge_length(complex, mesh.vertices[ub], mesh.cells[ub], criteria));
+      if ((mesh.vertices[ua] - mesh.vertices[ub]).squaredNorm() < limit * limit) drop[ub] = 1;
+    }
+  }
+  return drop;
+}
+
+// Whether the oriented triangles around v form one disk: the link edges
+// (a -> b for each triangle (v, a, b)) make a single closed cycle.
+bool star_is_disk(int v, const std::vector<Triangle>& around) {
+  if (around.size() < 3) return false;
+  std::unordered_map<int, int> next;
+  for (const Triangle& t : around) {
+    const size_t k = static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin());
+    if (!next.emplace(t[(k + 1) % 3], t[(k + 2) % 3]).second) return false;
+  }
+  const int start = next.begin()->first;
+  int at = start;
+  size_t steps = 0;
+  do {
+    const auto it = next.find(at);
+    if (it == next.end()) return false;
+    at = it->second;
+    ++steps;
+  } while (at != start && steps <= around.size());
+  return at == start && steps == around.size();
+}
+
+// The vertices of the mesh around which the seam fails: a patch vertex
+// whose triangles (kept ones plus the patch's) are not one disk, and the old corners of the patch triangles
+// around a new point whose star is not a disk. Empty when the seam holds.
+std::vector<int> seam_faults(const SurfaceMesh& merged, const std::vector<Triangle>& fresh,
+                             const std::vector<signed char>& role, const std::vector<char>& drop,
+                             size_t old_vertices) {
+  auto in_patch = [&](int v) {
+    return static_cast<size_t>(v) >= old_vertices ||
+           role[static_cast<size_t>(v)] == static_cast<signed char>(PatchRole::interior) ||
+           role[static_cast<size_t>(v)] == static_cast<signed char>(PatchRole::boundary);
+  };
+  std::unordered_map<int, std::vector<Triangle>> around;
+  for (const Triangle& t : fresh)
+    for (int v : t) around[v].push_back(t);
+  for (const Triangle& t : merged.triangles)
+    for (int v : t)
+      if (in_patch(v)) around[v].push_back(t);
+  std::vector<int> faults;
+  for (size_t v = 0; v < old_vertices; ++v)  // an interior vertex may go; a rim vertex has kept triangles
+    if (role[v] == static_cast<signed char>(PatchRole::boundary) && !drop[v] && !around.count(static_cast<int>(v)))
+      faults.push_back(static_cast<int>(v));
+  for (const auto& [v, triangles] : around) {
+    if (!in_patch(v) || star_is_disk(v, triangles)) continue;
+    if (static_cast<size_t>(v) < old_vertices) faults.push_back(v);
+    for (const Triangle& t : triangles)
+      for (int w : t)
+        if (static_cast<size_t>(w) < old_vertices) faults.push_back(w);
+  }
+  return faults;
+}
+
+// Components and Euler characteristic of a closed triangle mesh (vertices
+// counted where a triangle uses them).
+std::pair<long, long> components_and_euler(const SurfaceMesh& mesh) {
+  std::vector<int> parent(mesh.vertices.size(), -1);
+  std::function<int(int)> root = [&](int v) {
+    while (parent[static_cast<size_t>(v)] != v) {
+      int& up = parent[static_cast<size_t>(v)];
+      up = parent[static_cast<size_t>(up)];  // path halving
+      v = up;
+    }
+    return v;
+  };
+  long vertices = 0;
+  for (const Triangle& t : mesh.triangles)
+    for (int v : t)
+      if (parent[static_cast<size_t>(v)] < 0) {
+        parent[static_cast<size_t>(v)] = v;
+        ++vertices;
+      }
+  long components = vertices;
+  for (const Triangle& t : mesh.triangles)
+    for (size_t k = 1; k < 3; ++k) {
+      const int a = root(t[0]), b = root(t[k]);
+      if (a != b) {
+        parent[static_cast<size_t>(a)] = b;
+        --components;
+      }
+    }
+  // Closed: every edge in two triangles, so E = 3F/2.
+  const long faces = static_cast<long>(mesh.triangles.size());
+  return {components, vertices - 3 * faces / 2 + faces};
+}
+
+// Drops the vertices no triangle uses and renumbers; origin maps each
+// vertex back to the mesh before (or -1).
+void compact(const SurfaceMesh& merged, size_t old_vertices, LocalRepair& out) {
+  std::vector<int> renumber(merged.vertices.size(), -1);
+  for (const Triangle& t : merged.triangles)
+    for (int v : t) renumber[static_cast<size_t>(v)] = 0;
+  for (size_t v = 0; v < renumber.size(); ++v) {
+    if (renumber[v] < 0) continue;
+    renumber[v] = static_cast<int>(out.mesh.vertices.size());
+    out.mesh.vertices.push_back(merged.vertices[v]);
+    out.mesh.cells.push_back(merged.cells[v]);
+    out.mesh.normals.push_back(merged.normals[v]);
+    out.origin.push_back(v < old_vertices ? static_cast<long>(v) : -1);
+  }
+  for (const Triangle& t : merged.triangles)
+    out.mesh.triangles.push_back({renumber[static_cast<size_t>(t[0])], renumber[static_cast<size_t>(t[1])],
+                                  renumber[static_cast<size_t>(t[2])]});
+}
+
+}  // namespace
+
+std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                    const std::vector<Triangle>& triangles, const MeshingOptions& criteria) {
+  std::vector<char> bad(triangles.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const Triangle& t = triangles[i];
+      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
+                                                   mesh.vertices[static_cast<size_t>(t[1])],
+                                                   mesh.vertices[static_cast<size_t>(t[2])]};
+      const auto restricted =
+          restricted_triangle(complex, corners, criteria.tolerance, mesh.cells[static_cast<size_t>(t[0])]);
+      bad[i] = !restricted || triangle_defect(complex, *restricted, criteria) != TriangleDefect::none;
+    }
+  });
+  return bad;
+}
+
+// The patch's vertices and context as samples for mesh_patch; `index`
+// gets each sample's vertex in the mesh.
+std::vector<SkinSample> patch_samples(const SurfaceMesh& mesh, const std::vector<signed char>& role,
+                                      const std::vector<char>& drop, std::vector<PatchRole>& roles,
+                                      std::vector<int>& index) {
+  std::vector<SkinSample> samples;
+  for (int v = 0; v < static_cast<int>(role.size()); ++v) {
+    const auto u = static_cast<size_t>(v);
+    if (role[u] == kNone || drop[u]) continue;
+    samples.push_back({mesh.vertices[u], mesh.cells[u]});
+    roles.push_back(static_cast<PatchRole>(role[u]));
+    index.push_back(v);
+  }
+  return samples;
+}
+
+// The patch's triangles in the mesh's numbering (new points after the
+// mesh's vertices), without those the mesh keeps already.
+std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const PatchMeshResult& patch,
+                                      const std::vector<int>& index, const std::set<Triangle>& kept_near) {
+  const long n = static_cast<long>(index.size());
+  std::vector<Triangle> out;
+  for (const auto& t : patch.triangles) {
+    Triangle g;
+    for (size_t k = 0; k < 3; ++k)
+      g[k] = t[k] < n ? index[static_cast<size_t>(t[k])]
+                      : static_cast<int>(mesh.vertices.size() + static_cast<size_t>(t[k] - n));
+    Triangle key = g;
+    std::sort(key.begin(), key.end());
+    if (!kept_near.count(key)) out.push_back(g);
+  }
+  return out;
+}
+
+// One attempt on `region`: the patch meshed and stitched into `merged`.
+// `faults` gets the vertices to grow the region around when the seam or a
+// new triangle fails.
+struct Attempt {
+  bool ok = false;
+  SurfaceMesh merged;
+  long repairs = 0;
+  std::vector<int> faults;
+};
+
+Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
+                  const std::vector<char>& region, const MeshingOptions& repair, const MeshingOptions& accept,
+                  double crowded_below) {
+  Attempt a;
+  const std::vector<signed char> role = vertex_roles(mesh, stars, region);
+  const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, crowded_below);
+  std::vector<PatchRole> roles;
+  std::vector<int> index;
+  const std::vector<SkinSample> samples = patch_samples(mesh, role, drop, roles, index);
+  const PatchMeshResult patch = mesh_patch(complex, samples, roles, repair);
+  if (patch.status != MeshingStatus::ok) return a;  // no faults: growing would not help
+  a.merged.vertices = mesh.vertices;
+  a.merged.cells = mesh.cells;
+  a.merged.normals = mesh.normals;
+  for (const SkinSample& p : patch.added) {
+    a.merged.vertices.push_back(p.point);
+    a.merged.cells.push_back(p.cell);
+    a.merged.normals.push_back(complex.evaluate(p.point, p.cell).gradient.normalized());
+  }
+  std::set<Triangle> kept_near;  // kept triangles at the rim, by sorted corners
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (region[f]) continue;
+    a.merged.triangles.push_back(mesh.triangles[f]);
+    Triangle key = mesh.triangles[f];
+    std::sort(key.begin(), key.end());
+    if (std::any_of(key.begin(), key.end(), [&](int v) { return role[static_cast<size_t>(v)] != kNone; }))
+      kept_near.insert(key);
+  }
+  const std::vector<Triangle> fresh = patch_triangles(mesh, patch, index, kept_near);
+  a.faults = seam_faults(a.merged, fresh, role, drop, mesh.vertices.size());
+  const std::vector<char> bad = failing_triangles(complex, a.merged, fresh, accept);
+  for (size_t f = 0; f < fresh.size(); ++f)
+    if (bad[f])
+      for (int v : fresh[f])
+        if (static_cast<size_t>(v) < mesh.vertices.size()) a.faults.push_back(v);
+  if (!a.faults.empty()) return a;
+  a.merged.triangles.insert(a.merged.triangles.end(), fresh.begin(), fresh.end());
+  a.repairs = patch.stats.inserted_size + patch.stats.inserted_shape + patch.stats.inserted_distance +
+              patch.stats.inserted_topology;
+  a.ok = true;
+  return a;
+}
+
+LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                           const MeshingOptions& repair, const MeshingOptions& accept,
+                           const LocalRepairOptions& options) {
+  LocalRepair out;
+  const VertexStars stars(mesh);
+  std::vector<char> region = grow_region(mesh, stars, failing, options.rings);
+  for (int attempt = 0; attempt < options.attempts; ++attempt) {
+    Attempt a = try_patch(complex, mesh, stars, region, repair, accept, options.crowded_below);
+    if (a.ok) {
+      // Without a topology event the patch keeps the topology: a patch that
+      // grew a second layer or closed a piece off shows up here.
+      if (components_and_euler(a.merged) != components_and_euler(mesh)) return out;
+      out.patch_triangles = std::count(region.begin(), region.end(), 1);
+      compact(a.merged, mesh.vertices.size(), out);
+      out.repairs = a.repairs;
+      out.ok = true;
+      return out;
+    }
+    if (a.faults.empty()) return out;
+    std::vector<char> more(region.size(), 0);
+    for (int v : a.faults) stars.each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });
+    more = grow_region(mesh, stars, std::move(more), 1);
+    for (size_t f = 0; f < region.size(); ++f) region[f] = region[f] || more[f];
+  }
+  return out;
+}
+
+}  // namespace skinmesh::detail

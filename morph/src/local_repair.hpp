@@ -1,0 +1,45 @@
+// Local repair of a transported frame (private to morph/): the triangles
+// that fail the frame's criteria, grown by a few rings, are remeshed by
+// restricted Delaunay refinement of their own vertices (mesher's mesh_patch,
+// with a ring of context vertices around them) and stitched back. The seam
+// is checked: every vertex of the patch must end with one disk of
+// triangles, and every new triangle must meet the criteria; otherwise the
+// repair reports failure and the caller grows the patch or remeshes the frame.
+#pragma once
+
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+
+#include <array>
+#include <vector>
+
+namespace skinmesh::detail {
+
+struct LocalRepair {
+  bool ok = false;
+  SurfaceMesh mesh;          // the whole frame after the repair
+  std::vector<long> origin;  // per vertex: its index in the mesh before, or -1 when inserted
+  long repairs = 0;          // refinement insertions
+  long patch_triangles = 0;  // triangles replaced
+};
+
+struct LocalRepairOptions {
+  int rings = 2;               // rings of triangles around the failing ones
+  int attempts = 4;            // the patch grown around the seam's faults, at most this many times
+  double crowded_below = 0.4;  // interior vertices this close (times the target length) are removed
+};
+
+// `failing`: per triangle of `mesh`, non-zero where it fails `accept` on
+// the skin of `complex`. The patch is refined to `repair` (stricter, for
+// room before the next failure); its new triangles must meet `accept`.
+LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                           const MeshingOptions& repair, const MeshingOptions& accept,
+                           const LocalRepairOptions& options);
+
+// Per triangle, 1 where it fails the criteria (restricted_triangle, then
+// triangle_defect), in parallel.
+std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                    const std::vector<std::array<int, 3>>& triangles, const MeshingOptions& criteria);
+
+}  // namespace skinmesh::detail
