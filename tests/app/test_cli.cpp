@@ -340,3 +340,63 @@ TEST_CASE("an empty skin is said to be empty; non-UTF-8 names do not break --jso
   const nlohmann::json j = nlohmann::json::parse(r.output.substr(start));
   CHECK(j["molecule"].get<std::string>().find("\xef\xbf\xbd") != std::string::npos);  // U+FFFD
 }
+
+TEST_CASE("skinmesh morph writes a self-describing directory of checked frames", "[cli][morph]") {
+  char pattern[] = "/tmp/skinmesh-morph-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = std::string(pattern) + "/out";
+  const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
+  const Run r = run("morph " + file + " " + file + " --source-model 1 --target-model 3 --frames 4 -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  for (int k = 0; k < 4; ++k)
+    for (const char* ext : {"ply", "vtp"}) {
+      std::ifstream frame(dir + "/frame_000" + std::to_string(k) + "." + ext);
+      CHECK(frame.good());
+    }
+  std::ifstream ply(dir + "/frame_0002.ply");
+  std::string header, line;
+  while (std::getline(ply, line) && line != "end_header") header += line + "\n";
+  for (const char* property : {"property int id", "property int source_atom", "property int target_atom"})
+    CHECK(header.find(property) != std::string::npos);
+  // frames.jsonl: one object per frame with the fields a user plots.
+  std::ifstream jsonl(dir + "/frames.jsonl");
+  int frames = 0;
+  while (std::getline(jsonl, line)) {
+    const auto j = nlohmann::json::parse(line);
+    for (const char* key : {"t", "file", "vertices", "triangles", "min_angle", "share_below_bound", "moved",
+                            "relocated", "inserted", "removed", "repairs", "full_rebuild", "max_onsurf_error",
+                            "components", "euler", "seconds"})
+      CHECK(j.contains(key));
+    CHECK(j["min_angle"].get<double>() >= 20.0);
+    CHECK(j["max_onsurf_error"].get<double>() <= 1e-8);
+    ++frames;
+  }
+  CHECK(frames == 4);
+  std::ifstream pvd(dir + "/frames.pvd");
+  std::stringstream pvd_text;
+  pvd_text << pvd.rdbuf();
+  CHECK(pvd_text.str().find("frame_0003.vtp") != std::string::npos);
+  std::ifstream morph_json(dir + "/morph.json");
+  const auto m = nlohmann::json::parse(morph_json);
+  CHECK(m["alignment"]["method"] == "kabsch");
+  CHECK(m["alignment"]["matched_atoms"] == 78);
+  CHECK(m["frame_times"].size() == 4);
+  // The source's balls read back bit for bit from source.xyzr.
+  skinmesh::ReadOptions model1;
+  const auto original = skinmesh::balls_from_molecule(skinmesh::read_molecule(file, model1), 0.5);
+  const auto written = skinmesh::balls_from_molecule(skinmesh::read_molecule(dir + "/source.xyzr"), 0.5);
+  REQUIRE(written.size() == original.size());
+  for (size_t i = 0; i < written.size(); ++i) {
+    CHECK(written[i].center == original[i].center);
+    CHECK(written[i].weight == original[i].weight);
+  }
+  // Bad requests: nothing written, non-zero exit.
+  const std::string second = std::string(pattern) + "/second";
+  const Run backwards = run("morph " + file + " " + file + " --t 0.5,0.2 -o " + second);
+  CHECK(backwards.code != 0);
+  CHECK(backwards.output.find("increase") != std::string::npos);
+  std::ifstream none(second + "/morph.json");
+  CHECK_FALSE(none.good());
+  std::system(("rm -rf " + std::string(pattern)).c_str());
+}

@@ -1,8 +1,8 @@
-// The morph, frame by frame: every frame checked against the morph oracle
-// (vertices on the skin of B(t)), the frame's angle bound, the grader
-// (closed oriented manifold without self-intersections) and the static
-// mesher's mesh of the same frame (components, Euler characteristic); ids
-// kept by surviving vertices and never reused.
+// The morph in small steps: two balls whose skins join, transported
+// frame by frame (most frames kept by transport alone) and repaired where
+// the neck forms; every frame checked against the morph oracle, the
+// angle bound and the grader; ids kept by surviving vertices and never
+// reused. The acceptance tests on real pairs: test_morph_pairs.cpp.
 #include "test_support.hpp"
 #include "two_balls.hpp"
 
@@ -37,47 +37,6 @@ void check_ids(const std::vector<long>& before, const MorphFrame& f, std::set<lo
 }
 
 }  // namespace
-
-TEST_CASE("morph frames of 2k39 model 1 -> 2 are quality meshes of B(t)", "[morph][frames]") {
-  const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
-  const auto m2 = test::centred_model(test::data_file("2k39_3models.pdb"), 2);
-  MorphOptions options;
-  Morph morph = prepare_morph(m1, m2, 0.3, options);
-  const MorphOracle oracle(m1, m2, 0.5);
-  std::set<long> seen(morph.frame().ids.begin(), morph.frame().ids.end());
-  long rebuilds = 0, kept = 0;
-  for (double t : {0.302, 0.304, 0.306, 0.31, 0.32, 0.35}) {
-    INFO("t = " << t);
-    const std::vector<long> before = morph.frame().ids;
-    const MorphFrame& f = morph.advance_to(t);
-    INFO(f.stats.moved << " moved, " << f.stats.relocated << " relocated, " << f.stats.bad_triangles
-                       << " bad triangles, " << f.stats.events << " events, rebuilt " << f.stats.full_rebuild);
-    rebuilds += f.stats.full_rebuild;
-    double worst = 0;
-    for (const Eigen::Vector3d& v : f.mesh.vertices) {
-      const MorphOracleResult o = oracle.evaluate(v, t);
-      REQUIRE(o.certified);
-      worst = std::max(worst, o.distance());
-    }
-    CHECK(worst <= 1e-8);
-    const MeshQuality q = grade_mesh(f.mesh);
-    CHECK(q.min_angle >= options.frames.min_angle - 1e-9);
-    CHECK((q.closed && q.manifold && q.oriented && q.volume > 0));
-    CHECK(q.self_intersecting_pairs == 0);
-    GradeOptions topology_only;
-    topology_only.self_intersections = SelfIntersectionCheck::skip;
-    const MeshQuality fresh = grade_mesh(mesh_skin(morph.complex(), options.frames).mesh, topology_only);
-    CHECK(q.components == fresh.components);
-    CHECK(q.euler == fresh.euler);
-    kept += f.stats.vertices - f.stats.inserted;
-    check_ids(before, f, seen);
-  }
-  // Repair keeps the transported vertices: no frame is rebuilt, and most
-  // vertices survive every step.
-  CHECK(rebuilds == 0);
-  CHECK(kept > 6 * static_cast<long>(morph.frame().mesh.vertices.size()) / 2);
-  CHECK_THROWS_AS(morph.advance_to(0.2), ContractError);
-}
 
 TEST_CASE("morph frames of two balls: transported until their skins join, repaired there", "[morph][frames]") {
   const test::TwoBallMorph two;

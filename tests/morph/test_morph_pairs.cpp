@@ -1,0 +1,234 @@
+// The morph's acceptance tests: real pairs from data/ and synthetic
+// topology events, every frame checked against references independent of
+// the morph: the morph oracle (vertices on the skin of B(t), docs/math.md
+// section 4: m + n unknowns, blind to the complex and the live pairs), the
+// grader (angles, closed oriented manifold, CGAL's exact self-intersection
+// test), the static mesher's mesh of B(t) built from scratch (components,
+// Euler characteristic, two-sided distance by CGAL's AABB tree).
+#include "cgal_reference.hpp"
+#include "test_support.hpp"
+#include "two_balls.hpp"
+
+#include "skinmesh/core/interpolation.hpp"
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/morph/morph.hpp"
+#include "skinmesh/quality/guarantees.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+using namespace skinmesh;
+
+namespace {
+
+// B(t) from scratch: the balls themselves at the ends, the live pairs inside.
+std::vector<Ball> balls_at(const std::vector<Ball>& source, const std::vector<Ball>& target, double t) {
+  if (t == 0.0) return source;
+  if (t == 1.0) return target;
+  return interpolated_balls(source, target, live_pairs(source, target), t);
+}
+
+double farthest(const SurfaceMesh& from, const SurfaceMesh& to) {
+  double d = 0;
+  for (double x : test::distances_to_mesh(to, from.vertices)) d = std::max(d, x);
+  return d;
+}
+
+// What a frame is compared with: the static mesher's mesh of B(t) built
+// from scratch (components, Euler characteristic, two-sided distance), or,
+// for the synthetic sets whose B(t) the static mesher stalls on (exactly
+// symmetric balls), CGAL's certified skin mesh of B(t) jittered by 1e-9 A
+// (components and Euler characteristic).
+enum class Reference { static_mesher, cgal_skin };
+
+void check_against_reference(const SurfaceMesh& mesh, const MeshQuality& q, const std::vector<Ball>& balls,
+                             Reference reference, const MorphOptions& options) {
+  GradeOptions topology_only;
+  topology_only.self_intersections = SelfIntersectionCheck::skip;
+  if (reference == Reference::cgal_skin) {
+    const MeshQuality cgal = grade_mesh(test::cgal_skin_mesh(test::jittered(balls), options.shrink), topology_only);
+    CHECK(q.components == cgal.components);
+    CHECK(q.euler == cgal.euler);
+    return;
+  }
+  const SkinMeshResult fresh = mesh_skin(build_skin_complex(balls, {options.shrink}));  // at 30 degrees
+  INFO(fresh.message);
+  REQUIRE(fresh.status == MeshingStatus::ok);
+  const MeshQuality built = grade_mesh(fresh.mesh, topology_only);
+  CHECK(q.components == built.components);
+  CHECK(q.euler == built.euler);
+  // Each mesh lies within the tolerance of the skin, so within twice it of
+  // the other.
+  CHECK(farthest(mesh, fresh.mesh) <= 2 * options.frames.tolerance);
+  CHECK(farthest(fresh.mesh, mesh) <= 2 * options.frames.tolerance);
+}
+
+struct FrameRecord {
+  double t;
+  long components, euler, cavities;
+};
+
+// Advances through `times` (the first is the first frame) and checks every
+// frame; returns what each frame's topology was.
+std::vector<FrameRecord> check_frames(const std::vector<Ball>& source, const std::vector<Ball>& target,
+                                      const std::vector<double>& times, Reference reference,
+                                      const MorphOptions& options = {}) {
+  const MorphOracle oracle(source, target, options.shrink);
+  Morph morph = prepare_morph(source, target, times.front(), options);
+  std::set<long> seen;
+  std::vector<FrameRecord> records;
+  for (size_t k = 0; k < times.size(); ++k) {
+    const double t = times[k];
+    INFO("t = " << t);
+    const std::vector<long> before = morph.frame().ids;
+    const MorphFrame& f = k == 0 ? morph.frame() : morph.advance_to(t);
+    INFO(f.stats.bad_triangles << " failing after transport, repaired " << f.stats.repaired << ", remeshed "
+                               << f.stats.remeshed << ", rebuilt " << f.stats.full_rebuild);
+    double worst = 0;
+    for (const Eigen::Vector3d& v : f.mesh.vertices) {
+      const MorphOracleResult o = oracle.evaluate(v, t);
+      REQUIRE(o.certified);
+      worst = std::max(worst, o.distance());
+    }
+    CHECK(worst <= 1e-8);
+    const MeshQuality q = grade_mesh(f.mesh);
+    CHECK(q.min_angle >= options.frames.min_angle - 1e-9);
+    CHECK((q.closed && q.manifold && q.oriented && q.volume > 0));
+    CHECK((q.self_intersections_checked && q.self_intersecting_pairs == 0));
+    check_against_reference(f.mesh, q, balls_at(source, target, t), reference, options);
+    // Ids: unique; survivors keep theirs; new ones never seen before.
+    const std::set<long> now(f.ids.begin(), f.ids.end());
+    CHECK(now.size() == f.ids.size());
+    const std::set<long> previous(before.begin(), before.end());
+    for (long id : now)
+      if (!previous.count(id) && k > 0) CHECK(seen.count(id) == 0);
+    seen.insert(now.begin(), now.end());
+    // The atoms of a vertex are a pair of balls of the cell it lies in.
+    const std::vector<std::array<int, 2>> atoms = morph.vertex_atoms();
+    for (size_t v = 0; v < atoms.size(); v += 7) {
+      const MixedCell& cell = morph.complex().cell(f.mesh.cells[v]);
+      const int own = atoms[v][0] >= 0 && atoms[v][1] >= 0 ? -2 : (atoms[v][0] >= 0 ? atoms[v][0] : atoms[v][1]);
+      bool found = false;
+      for (int j = 0; j <= cell.dim; ++j) {
+        const int b = cell.balls[static_cast<size_t>(j)];
+        if (own != -2) found = found || b == own;
+        else found = found || morph.pairs()[static_cast<size_t>(b)] == BallPair{atoms[v][0], atoms[v][1]};
+      }
+      CHECK(found);
+    }
+    records.push_back({t, q.components, q.euler, q.cavities});
+  }
+  // The last frame at t = 1 is a static quality mesh of the target.
+  if (times.back() == 1.0) {
+    GuaranteeOptions bounds;
+    bounds.min_angle = options.frames.min_angle;
+    CHECK(check_guarantees(morph.frame().mesh, target, options.shrink, bounds).all_hold());
+  }
+  return records;
+}
+
+// Every change of topology between two frames has a reported event between them.
+void check_events_cover_changes(const Morph& morph, const std::vector<FrameRecord>& records) {
+  for (size_t k = 1; k < records.size(); ++k) {
+    if (records[k].components == records[k - 1].components && records[k].euler == records[k - 1].euler) continue;
+    INFO("topology changes between t = " << records[k - 1].t << " and " << records[k].t);
+    CHECK(std::any_of(morph.events().begin(), morph.events().end(), [&](const TopologyEvent& e) {
+      return e.t > records[k - 1].t && e.t <= records[k].t;
+    }));
+  }
+}
+
+std::vector<Ball> molecule_balls(const char* file, int model = 1) {
+  ReadOptions read;
+  read.model = model;
+  std::vector<Ball> balls = balls_from_molecule(read_molecule(test::data_file(file), read), 0.5);
+  centre_balls(balls);
+  return balls;
+}
+
+const std::vector<double> kSixFrames{0.0, 0.2, 0.4, 0.6, 0.8, 1.0};
+
+Ball lone(double x, double y, double z, double skin_radius) {
+  return {Eigen::Vector3d(x, y, z), skin_radius * skin_radius / 0.5};
+}
+
+}  // namespace
+
+TEST_CASE("morph pept -> 3al1: every frame a quality mesh of B(t)", "[morph][pairs]") {
+  check_frames(molecule_balls("pept.pdb"), molecule_balls("3al1.pdb"), kSixFrames, Reference::static_mesher);
+}
+
+TEST_CASE("morph 3al1 -> 1ejg, two different molecules: every frame a quality mesh of B(t)", "[morph][pairs]") {
+  check_frames(molecule_balls("3al1.pdb"), molecule_balls("1ejg.pdb"), kSixFrames, Reference::static_mesher);
+}
+
+TEST_CASE("morph 2k39 model 1 -> 2, atoms barely moving: every frame a quality mesh of B(t)", "[morph][pairs]") {
+  check_frames(molecule_balls("2k39_3models.pdb", 1), molecule_balls("2k39_3models.pdb", 2), kSixFrames,
+               Reference::static_mesher);
+}
+
+TEST_CASE("synthetic events: two balls merge, and the neck pinches off going back", "[morph][events]") {
+  const test::TwoBallMorph two;
+  std::vector<double> times;
+  for (int k = 0; k <= 20; ++k) times.push_back(k / 20.0);
+  for (bool forward : {true, false}) {
+    INFO((forward ? "merging" : "pinching off"));
+    const auto& source = forward ? two.source : two.target;
+    const auto& target = forward ? two.target : two.source;
+    const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin);
+    CHECK(records.front().components == (forward ? 2 : 1));
+    CHECK(records.back().components == (forward ? 1 : 2));
+    check_events_cover_changes(prepare_morph(source, target, 0.0), records);
+  }
+}
+
+TEST_CASE("synthetic events: a component is born and one dies", "[morph][events]") {
+  const std::vector<Ball> one{lone(0, 0, 0, 1.5)};
+  const std::vector<Ball> two{lone(0, 0, 0, 1.5), lone(6, 0, 0, 1.5)};
+  std::vector<double> times;
+  for (int k = 0; k <= 20; ++k) times.push_back(k / 20.0);
+  for (bool born : {true, false}) {
+    INFO((born ? "born" : "dies"));
+    const auto& source = born ? one : two;
+    const auto& target = born ? two : one;
+    const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin);
+    CHECK(records.front().components == (born ? 1 : 2));
+    CHECK(records.back().components == (born ? 2 : 1));
+    check_events_cover_changes(prepare_morph(source, target, 0.0), records);
+  }
+}
+
+TEST_CASE("synthetic events: a void closes", "[morph][events]") {
+  // Six balls near the axes around a void at the origin; in the target they
+  // move inwards and the void fills. Off exact symmetry by a few hundredths
+  // of an Angstrom: on the exactly symmetric set the static mesher stalls
+  // (numerically degenerate Delaunay tetrahedra), a mesher limit noted in
+  // docs/morph.md.
+  auto octahedron = [](double d) {
+    std::vector<Ball> balls;
+    int k = 0;
+    for (int axis = 0; axis < 3; ++axis)
+      for (double sign : {-1.0, 1.0}) {
+        Eigen::Vector3d c = 0.01 * Eigen::Vector3d(std::sin(1.3 * k), std::cos(2.1 * k), std::sin(0.7 * k + 1));
+        c[axis] += sign * d;
+        balls.push_back({c, (1.5 + 0.01 * k) * (1.5 + 0.01 * k) / 0.5});
+        ++k;
+      }
+    return balls;
+  };
+  const std::vector<Ball> source = octahedron(2.6), target = octahedron(1.6);
+  const MorphOracle oracle(source, target, 0.5);
+  REQUIRE(oracle.evaluate(Eigen::Vector3d::Zero(), 0.0).value > 0);  // a void at the source
+  REQUIRE(oracle.evaluate(Eigen::Vector3d::Zero(), 1.0).value < 0);  // filled at the target
+  std::vector<double> times;
+  for (int k = 0; k <= 20; ++k) times.push_back(k / 20.0);
+  const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin);
+  CHECK(records.front().cavities == 1);
+  CHECK(records.back().cavities == 0);
+  check_events_cover_changes(prepare_morph(source, target, 0.0), records);
+}
