@@ -228,6 +228,8 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
   return bad;
 }
 
+namespace {
+
 // The patch's vertices and context as samples for mesh_patch; `index`
 // gets each sample's vertex in the mesh.
 std::vector<SkinSample> patch_samples(const SurfaceMesh& mesh, const std::vector<signed char>& role,
@@ -314,6 +316,8 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   a.ok = true;
   return a;
 }
+
+}  // namespace
 
 LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,

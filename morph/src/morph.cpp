@@ -45,9 +45,9 @@ Morph::Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<Bal
   events_ = critical_events(topology_events(sizes), sizes, middle_, pairs_, oracle);
 }
 
-void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria) {
+void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t) {
   SkinMeshResult made = mesh_skin(next, criteria);
-  if (made.status != MeshingStatus::ok) throw Error("morph frame at t = " + std::to_string(t_) + ": " + made.message);
+  if (made.status != MeshingStatus::ok) throw Error("morph frame at t = " + std::to_string(t) + ": " + made.message);
   frame_.mesh = std::move(made.mesh);
   frame_.ids.resize(frame_.mesh.vertices.size());
   for (long& id : frame_.ids) id = next_id_++;
@@ -189,13 +189,18 @@ void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
   stats.relocated = static_cast<long>(lost.size()) - stats.lost;
   frame_.stats = stats;
   const auto repair_start = Clock::now();
-  if (!repair(next, moved, lost)) {
-    const long before = static_cast<long>(frame_.mesh.vertices.size());
-    rebuild(next, options_.repair_criteria());
-    frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
-    frame_.stats.removed = before;
-  }
+  remesh_or_rebuild(next, moved, lost);
   frame_.stats.seconds_repair = seconds_since(repair_start);
+}
+
+// The whole frame remeshed from its transported vertices, or, when the
+// mesher cannot, meshed from scratch (counted as a full rebuild).
+void Morph::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
+  if (repair(next, moved, drop)) return;
+  const long before = static_cast<long>(frame_.mesh.vertices.size());
+  rebuild(next, options_.repair_criteria(), frame_.stats.t);
+  frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
+  frame_.stats.removed = before;
 }
 
 void Morph::finish_frame(double t, Clock::time_point start) {
@@ -237,18 +242,9 @@ const MorphFrame& Morph::advance_to(double t) {
     const auto repair_start = Clock::now();
     const bool local = stats.events == 0 && stats.lost == 0 &&
                        stats.bad_triangles <= options_.local_repair_share * static_cast<double>(failing.size());
-    if (local && repair_locally(next, moved, failing)) {
-      frame_.stats.seconds_repair = seconds_since(repair_start);
-      current_ = next;
-      finish_frame(t, start);
-      return frame_;
-    }
-    frame_.stats.crowded = mark_crowded(next, moved, drop);
-    if (!repair(next, moved, drop)) {
-      const long before = static_cast<long>(frame_.mesh.vertices.size());
-      rebuild(next, options_.repair_criteria());
-      frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
-      frame_.stats.removed = before;
+    if (!(local && repair_locally(next, moved, failing))) {
+      frame_.stats.crowded = mark_crowded(next, moved, drop);
+      remesh_or_rebuild(next, moved, drop);
     }
     frame_.stats.seconds_repair = seconds_since(repair_start);
   }
@@ -281,7 +277,7 @@ Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t
                        ? morph.middle_.with_balls(interpolated_balls(morph.source_, morph.target_, morph.pairs_, t0))
                        : build_skin_complex(morph.source_, {options.shrink});
   morph.t_ = t0;
-  morph.rebuild(morph.current_, options.first_criteria());
+  morph.rebuild(morph.current_, options.first_criteria(), t0);
   morph.frame_.stats.inserted = static_cast<long>(morph.frame_.mesh.vertices.size());
   morph.finish_frame(t0, start);
   return morph;

@@ -114,7 +114,8 @@ class Morph {
                              const MorphOptions& options);
   Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
         const MorphOptions& options);
-  void rebuild(const SkinComplex& next, const MeshingOptions& criteria);
+  void rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t);
+  void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
   bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing);
