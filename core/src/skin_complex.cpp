@@ -8,9 +8,12 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <unordered_set>
+#include <vector>
 
 namespace skinmesh {
 namespace {
@@ -18,6 +21,8 @@ namespace {
 constexpr double kBaryTolerance = 1e-12;   // dimensionless
 constexpr double kPlaneTolerance = 1e-11;  // Angstrom
 constexpr int kMaxWalkSteps = 400;
+constexpr int kWalkMemory = 8;       // cells a walk remembers to notice a cycle
+constexpr size_t kNearCells = 512;   // cells searched around a cycle before a search of all
 
 // What is wrong with "x in mu_c": the worst violated constraint and the cell
 // across it. amount <= 0: x is in the cell.
@@ -196,14 +201,41 @@ int SkinComplex::locate_by_search(const Eigen::Vector3d& x) const {
   return best;
 }
 
+int SkinComplex::locate_near(const Eigen::Vector3d& x, int from) const {
+  std::vector<int> queue{from};
+  std::unordered_set<int> seen{from};
+  for (size_t next = 0; next < queue.size() && queue.size() < kNearCells; ++next) {
+    const int c = queue[next];
+    if (worst_violation(*this, c, x).target < 0) return c;
+    auto visit = [&](int d) {
+      if (seen.insert(d).second) queue.push_back(d);
+    };
+    std::for_each(faces_begin(c), faces_end(c), visit);
+    for (auto it = cofaces_begin(c); it != cofaces_end(c); ++it) visit(it->cell);
+  }
+  return -1;
+}
+
 int SkinComplex::locate(const Eigen::Vector3d& x, int hint) const {
   int c = (hint >= 0 && hint < static_cast<int>(cells_.size())) ? hint : start_cell(x);
+  std::array<int, kWalkMemory> recent;
+  recent.fill(-1);
   for (int step = 0; step < kMaxWalkSteps; ++step) {
     const Violation v = worst_violation(*this, c, x);
     if (v.target < 0) return c;
+    // A walk goes round in a cycle where a cell of (numerically) zero size
+    // sits between x and its cell: on B(t) of a morph, a triangle whose two
+    // tetrahedra have the same orthocentre (five co-orthogonal balls) is
+    // such a cell, and its coface test points to the wrong tetrahedron by
+    // ~1e-9 A. The cell holding x is then a near neighbour of the cycle.
+    if (std::find(recent.begin(), recent.end(), c) != recent.end()) {
+      const int near = locate_near(x, c);
+      return near >= 0 ? near : locate_by_search(x);
+    }
+    recent[static_cast<size_t>(step) % kWalkMemory] = c;
     c = v.target;
   }
-  return locate_by_search(x);  // the walk cycled (never seen on real input; kept as a safety net)
+  return locate_by_search(x);  // a walk this long is not expected; kept as a safety net
 }
 
 SkinEval SkinComplex::evaluate(const Eigen::Vector3d& x, int hint) const {

@@ -63,6 +63,35 @@ TEST_CASE("a frame's complex moved from another has the frame's skin function", 
   }
 }
 
+// Walks from a neighbouring cell are what transport and the mesher's
+// crossings do. On B(t) some cells have (numerically) zero size, and a walk
+// through one can go round in a cycle; wherever it starts, the cell found
+// must hold the point.
+TEST_CASE("a walk from any neighbouring cell of a frame's complex ends in a cell holding the point", "[morph]") {
+  for (const MorphPair& m : morph_pairs()) {
+    INFO(m.name);
+    const std::vector<BallPair> live = live_pairs(m.source, m.target);
+    const SkinComplex middle = build_skin_complex(interpolated_balls(m.source, m.target, live, 0.5), {0.5});
+    const SkinComplex moved = frame(middle, m, live, 0.3);
+    const SkinMeshResult mesh = mesh_skin(moved);
+    REQUIRE(mesh.status == MeshingStatus::ok);
+    long walks = 0, failed = 0;
+    for (size_t v = 0; v < mesh.mesh.vertices.size(); v += 3) {
+      const Eigen::Vector3d& x = mesh.mesh.vertices[v];
+      const int home = mesh.mesh.cells[v];
+      std::vector<int> starts(moved.faces_begin(home), moved.faces_end(home));
+      for (auto it = moved.cofaces_begin(home); it != moved.cofaces_end(home); ++it) starts.push_back(it->cell);
+      for (int start : starts) {
+        ++walks;
+        failed += moved.membership_violation(moved.locate(x, start), x) > 1e-9;
+      }
+    }
+    INFO(walks << " walks");
+    CHECK(walks > 1000);
+    CHECK(failed == 0);
+  }
+}
+
 TEST_CASE("transport puts a skin point that stays in its cell on the next frame's skin", "[morph]") {
   for (const MorphPair& m : morph_pairs()) {
     INFO(m.name);

@@ -147,6 +147,7 @@ class SkinComplex {
   int start_cell(const Eigen::Vector3d& x) const;
   Projection project_onto(const Eigen::Vector3d& x, int hint, double tolerance) const;
   std::optional<SegmentCrossing> nearest_crossing_on_rays(const Eigen::Vector3d& x, double reach, int hint) const;
+  int locate_near(const Eigen::Vector3d& x, int from) const;  // breadth-first from a cell; -1 if not near
   int locate_by_search(const Eigen::Vector3d& x) const;
   // Ball ids ascending, unused entries (-1) last: the order of MixedCell::balls.
   static std::array<int, 4> ball_tuple(std::array<int, 4> ids);
