@@ -244,6 +244,27 @@ TEST_CASE("edge contraction removes short edges and keeps every guarantee", "[me
   CHECK(short_edges(complex, after.mesh, cleaned, 0.5) < short_edges(complex, before.mesh, plain, 0.5));
 }
 
+// CGAL orders its triangulation's cells partly by memory address; the
+// mesher must not inherit that order. Calls with different heap histories
+// in between (and different thread counts) make the same mesh, vertex for
+// vertex and triangle for triangle.
+TEST_CASE("the mesher makes the same mesh in every call", "[mesher][determinism]") {
+  const SkinComplex complex = build_skin_complex(test::centred_model(test::data_file("pept.pdb"), 1));
+  const SkinMeshResult first = mesh_skin(complex);
+  REQUIRE(first.status == MeshingStatus::ok);
+  for (int threads : {1, 2, 0}) {
+    INFO("threads " << threads);
+    std::vector<std::vector<double>> clutter;  // moves later allocations elsewhere
+    for (int k = 0; k < 200; ++k) clutter.emplace_back(static_cast<size_t>(17 * k + 3), 1.0);
+    MeshingOptions options;
+    options.threads = threads;
+    const SkinMeshResult again = mesh_skin(complex, options);
+    REQUIRE(again.status == MeshingStatus::ok);
+    CHECK(again.mesh.vertices == first.mesh.vertices);
+    CHECK(again.mesh.triangles == first.mesh.triangles);
+  }
+}
+
 TEST_CASE("mesh vertices carry their mixed cell and outward normal", "[mesher]") {
   const auto balls = molecule_balls(data_file("pept.pdb"));
   const SkinComplex complex = build_skin_complex(balls, {0.5});

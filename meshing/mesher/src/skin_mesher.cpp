@@ -244,13 +244,23 @@ void Refiner::push_repair(FacetEval e) {
 // Every facet of the star of a new vertex is new or has a new Voronoi edge;
 // each is listed once (the cells of the star are the ones the insertion made).
 std::vector<Facet> Refiner::star_facets(Vertex_handle v) const {
+  // A facet through v lies in two cells of the star: it is listed from the
+  // one made first. (Comparing the cells' addresses instead made the order of
+  // refinement, hence the mesh, differ from one call to the next.)
+  std::unordered_map<const void*, size_t> made;
+  made.reserve(star_.size());
+  for (size_t k = 0; k < star_.size(); ++k) made.emplace(&*star_[k], k);
   std::vector<Facet> out;
-  for (const Cell_handle& c : star_) {
+  for (size_t k = 0; k < star_.size(); ++k) {
+    const Cell_handle& c = star_[k];
     const bool infinite = dt_.is_infinite(c);
     const int iv = c->index(v);
     for (int j = 0; j < 4; ++j) {
       if (infinite && j != c->index(dt_.infinite_vertex())) continue;  // only its finite facet
-      if (j != iv && &*c->neighbor(j) < &*c) continue;  // a facet through v lies in two cells of the star
+      if (j != iv) {
+        const auto other = made.find(&*c->neighbor(j));
+        if (other != made.end() && other->second < k) continue;
+      }
       out.emplace_back(c, j);
     }
   }
@@ -269,7 +279,11 @@ std::vector<FacetEval> Refiner::evaluate_all(const std::vector<Facet>& facets) c
 // largest ball, evaluate the facets of the new vertex's star, repeat. An entry
 // whose cells changed since its evaluation is evaluated again first.
 void Refiner::refine() {
-  auto smaller = [](const FacetEval& a, const FacetEval& b) { return a.radius < b.radius; };
+  // Ties broken by the facet's vertex ids: CGAL's containers are ordered by
+  // memory addresses in places, and the order of refinement must not be.
+  auto smaller = [](const FacetEval& a, const FacetEval& b) {
+    return a.radius < b.radius || (a.radius == b.radius && facet_key(a) > facet_key(b));
+  };
   std::priority_queue<FacetEval, std::vector<FacetEval>, decltype(smaller)> queue(smaller, std::move(pending_));
   pending_.clear();
   while (!queue.empty()) {
@@ -375,6 +389,11 @@ bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
   const std::vector<FacetEval> evals = evaluate_all(facets);
   for (const FacetEval& e : evals)
     if (e.crossings > 0) restricted->push_back(e);
+  // In the order of their vertex ids, not of CGAL's containers (whose order
+  // depends on memory addresses): the mesh, the order of its vertices and of
+  // the repairs are then the same in every call and every process.
+  std::sort(restricted->begin(), restricted->end(),
+            [](const FacetEval& a, const FacetEval& b) { return facet_key(a) < facet_key(b); });
   pass_cache_.clear();
   pass_cache_.reserve(restricted->size());
   for (const FacetEval& e : *restricted)
@@ -393,6 +412,7 @@ bool Refiner::global_pass(std::vector<FacetEval>* restricted) {
   std::vector<Vertex_handle> all;
   all.reserve(dt_.number_of_vertices());
   for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end(); ++v) all.push_back(v);
+  std::sort(all.begin(), all.end(), [](Vertex_handle a, Vertex_handle b) { return a->info().id < b->info().id; });
   return repair_stars(*restricted, star_checked_only(std::move(all)));
 }
 
