@@ -223,18 +223,23 @@ class OutputDirectory {
     } else {
       made_ = fs::create_directory(path_, error);
       if (!made_) output_error(path, "cannot make the output directory (" + error.message() + ")");
+      removed_on_interrupt_.emplace_back(path_.string());
     }
   }
   ~OutputDirectory() {
     std::error_code error;
     if (made_ && !kept_ && fs::is_empty(path_, error)) fs::remove(path_, error);
   }
-  void keep() { kept_ = true; }
+  void keep() {
+    kept_ = true;
+    removed_on_interrupt_.clear();
+  }
   std::string file(const std::string& name) const { return (path_ / name).string(); }
 
  private:
   fs::path path_;
   bool made_ = false, kept_ = false;
+  std::vector<RemovedOnInterrupt> removed_on_interrupt_;  // the directory, while made and not kept
 };
 
 std::string frame_name(size_t k, const std::string& format) {

@@ -1,12 +1,14 @@
 // skinmesh: molecular skin surfaces, quality meshes and morphs.
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "interrupt.hpp"
 
 #include "skinmesh/core/error.hpp"
 
 #include <iostream>
 
 int main(int argc, char** argv) {
+  skinmesh::app::watch_interrupts();  // first: before any thread starts
   CLI::App app{"skinmesh: quality meshes of molecular skin surfaces"};
   app.require_subcommand(1);
   app.fallthrough();  // --json and --quiet may follow the subcommand

@@ -12,12 +12,12 @@
 namespace skinmesh::app {
 
 OutputSet::~OutputSet() {
-  for (const auto& [temporary, target] : staged_) std::remove(temporary.c_str());
+  for (const Staged& s : staged_) std::remove(s.temporary.c_str());
 }
 
 void OutputSet::add(const std::string& path, const std::function<void(std::ostream&)>& write) {
   const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
-  staged_.emplace_back(temporary, path);  // removed by the destructor from here on
+  staged_.push_back({temporary, path, RemovedOnInterrupt(temporary)});  // removed by the destructor from here on
   std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
   if (!out) output_error(path, std::string("cannot write (") + std::strerror(errno) + ")");
   write(out);
@@ -26,10 +26,14 @@ void OutputSet::add(const std::string& path, const std::function<void(std::ostre
 }
 
 void OutputSet::commit() {
+  // An interrupt while the set is renamed removes what is in place so far.
+  std::vector<RemovedOnInterrupt> placed;
+  placed.reserve(staged_.size());
   while (!staged_.empty()) {
-    const auto [temporary, target] = staged_.front();
-    if (std::rename(temporary.c_str(), target.c_str()) != 0)
-      output_error(target, std::string("cannot rename into place (") + std::strerror(errno) + ")");
+    const Staged& s = staged_.front();
+    placed.emplace_back(s.target);
+    if (std::rename(s.temporary.c_str(), s.target.c_str()) != 0)
+      output_error(s.target, std::string("cannot rename into place (") + std::strerror(errno) + ")");
     staged_.erase(staged_.begin());
   }
 }

@@ -1,13 +1,15 @@
 // All outputs of one command are written together or not at all: each file
 // goes to a temporary beside its target, and only when every one of them has
 // been written are they renamed into place. A failure (or a command that
-// ends before commit()) leaves no file behind.
+// ends before commit()) leaves no file behind, nor does an interrupt
+// (interrupt.hpp), during commit() included.
 #pragma once
+
+#include "interrupt.hpp"
 
 #include <functional>
 #include <ostream>
 #include <string>
-#include <utility>
 #include <vector>
 
 namespace skinmesh::app {
@@ -26,7 +28,11 @@ class OutputSet {
   void commit();
 
  private:
-  std::vector<std::pair<std::string, std::string>> staged_;  // (temporary, target)
+  struct Staged {
+    std::string temporary, target;
+    RemovedOnInterrupt guard;  // of the temporary
+  };
+  std::vector<Staged> staged_;
 };
 
 // Checks, before any work, that each path can be written: not a directory,

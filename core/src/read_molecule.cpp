@@ -158,6 +158,18 @@ void add_atoms_with_radii(const std::string& path, std::vector<detail::RawAtom> 
         input_error(path, a.line, msg.str());
       }
     }
+    // Past these, squares and powers overflow or lose every digit of the
+    // coordinates (a radius of 1e200 squares to infinity).
+    if (r.radius_given && !(a.radius <= kMaxCoordinate)) {
+      std::ostringstream msg;
+      msg << "radius " << a.radius << " is beyond " << kMaxCoordinate << " Angstrom: not an atom";
+      input_error(path, a.line, msg.str());
+    }
+    if (a.weight && !(std::abs(*a.weight) <= kMaxCoordinate * kMaxCoordinate)) {
+      std::ostringstream msg;
+      msg << "weight " << *a.weight << " is beyond +-" << kMaxCoordinate * kMaxCoordinate << " Angstrom^2";
+      input_error(path, a.line, msg.str());
+    }
     if (!r.radius_given) {
       if (auto radius = bondi_radius(a.element)) {
         a.radius = *radius;

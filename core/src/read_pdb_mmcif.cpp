@@ -107,6 +107,18 @@ PdbPrepass prepass_pdb(const std::string& path, const std::string& text) {
   return out;
 }
 
+// gemmi skips an _atom_site table without coordinates, which would leave
+// "no atoms found"; name the column instead.
+void check_atom_site_columns(gemmi::cif::Document& doc, const std::string& path) {
+  for (gemmi::cif::Block& block : doc.blocks) {
+    if (!block.find_mmcif_category("_atom_site.").ok()) continue;
+    for (const char* tag : {"_atom_site.Cartn_x", "_atom_site.Cartn_y", "_atom_site.Cartn_z"})
+      if (!block.has_tag(tag))
+        input_error(path, 0, std::string("data block '") + block.name + "': the _atom_site table has no " + tag +
+                                 " column");
+  }
+}
+
 }  // namespace
 
 std::vector<RawModel> read_pdb_or_mmcif(const std::string& path, std::string text, MoleculeFormat format,
@@ -123,6 +135,7 @@ std::vector<RawModel> read_pdb_or_mmcif(const std::string& path, std::string tex
       structure = gemmi::read_pdb_from_memory(prepass.text.data(), prepass.text.size(), path);
     } else {
       gemmi::cif::Document doc = gemmi::cif::read_memory(text.data(), text.size(), path.c_str());
+      check_atom_site_columns(doc, path);
       structure = gemmi::make_structure(doc);
     }
   } catch (const InputError&) {

@@ -12,8 +12,12 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <csignal>
+#include <fcntl.h>
 #include <cstdio>
+#include <filesystem>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace {
 
@@ -399,4 +403,47 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   std::ifstream none(second + "/morph.json");
   CHECK_FALSE(none.good());
   std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
+// An interrupted morph leaves nothing: the frames staged so far, their
+// temporaries and the directory it made are removed, and the process ends
+// by the signal. The signal is sent once a frame's temporary exists.
+TEST_CASE("an interrupted command leaves no output behind", "[cli][bad][interrupt]") {
+  const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
+  for (int signal : {SIGTERM, SIGINT}) {
+    INFO("signal " << signal);
+    char pattern[] = "/tmp/skinmesh-interrupt-XXXXXX";
+    REQUIRE(mkdtemp(pattern) != nullptr);
+    const std::string dir = std::string(pattern) + "/out";
+    const pid_t pid = fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) {
+      const int quiet = open("/dev/null", O_WRONLY);  // only async-signal-safe calls after fork
+      dup2(quiet, 1);
+      dup2(quiet, 2);
+      execl(SKINMESH_BINARY, SKINMESH_BINARY, "morph", file.c_str(), file.c_str(), "--source-model", "1",
+            "--target-model", "3", "--frames", "200", "-o", dir.c_str(), static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+    auto staged = [&] {
+      std::error_code error;
+      for (const auto& entry : std::filesystem::directory_iterator(dir, error))
+        if (entry.path().filename().string().find(".tmp-") != std::string::npos) return true;
+      return false;
+    };
+    bool seen = false;
+    for (int wait = 0; wait < 1200 && !seen; ++wait) {  // at most 60 s
+      usleep(50000);
+      seen = staged();
+    }
+    CHECK(seen);
+    kill(pid, signal);
+    int status = 0;
+    REQUIRE(waitpid(pid, &status, 0) == pid);
+    CHECK(WIFSIGNALED(status));
+    if (WIFSIGNALED(status)) CHECK(WTERMSIG(status) == signal);
+    CHECK_FALSE(std::filesystem::exists(dir));
+    CHECK(std::filesystem::is_empty(pattern));
+    std::filesystem::remove_all(pattern);
+  }
 }

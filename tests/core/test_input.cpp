@@ -316,6 +316,24 @@ TEST_CASE("bad input: an enormous coordinate", "[input][bad]") {
   expect_input_error(exp_pdb.path(), 2, "malformed or non-finite x coordinate");
 }
 
+TEST_CASE("bad input: a radius or weight whose square overflows names the file and line", "[input][bad]") {
+  TempFile radius("r.xyzr", "0 0 0 1.5\n1 0 0 1e200\n");
+  expect_input_error(radius.path(), 2, "radius");
+  TempFile pqr("r.pqr", "ATOM      1  N   GLY A   1       0.000   0.000   0.000  0.0 1.5\n"
+                        "ATOM      2  CA  GLY A   1       1.000   0.000   0.000  0.0 1e160\n");
+  expect_input_error(pqr.path(), 2, "radius");
+  TempFile weight("w.wpts", "0 0 0 2\n1 0 0 -1e300\n");
+  expect_input_error(weight.path(), 2, "weight");
+}
+
+TEST_CASE("bad input: an mmCIF atom table without a coordinate column says which", "[input][bad]") {
+  TempFile cif("noz.cif", "data_x\nloop_\n_atom_site.group_PDB\n_atom_site.id\n_atom_site.type_symbol\n"
+                          "_atom_site.label_atom_id\n_atom_site.label_comp_id\n_atom_site.label_asym_id\n"
+                          "_atom_site.label_seq_id\n_atom_site.Cartn_x\n_atom_site.Cartn_y\n"
+                          "ATOM 1 N N GLY A 1 0.0 0.0\n");
+  expect_input_error(cif.path(), 0, "_atom_site.Cartn_z");
+}
+
 TEST_CASE("unknown elements: fallback radius with a report, or an error when strict", "[input][bad]") {
   TempFile f("fe.pdb", pdb_atom(1, " N", "GLY", 'A', 1, 0, 0, 0, "N") +
                            "HETATM    2 FE   HEM A   2       3.000   0.000   0.000  1.00 10.00          FE\n");

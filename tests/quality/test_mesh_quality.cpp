@@ -156,7 +156,10 @@ TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {
   std::string bply = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(t.vertices.size()) +
                      "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
                      std::to_string(t.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
-  std::string bstl(80, ' ');
+  // Some writers begin a binary STL's header with the ASCII keyword; the
+  // size announced by its triangle count says it is binary.
+  std::string bstl = "solid written by a tool that puts facet normals in its header";
+  bstl.resize(80, ' ');
   const uint32_t nf = static_cast<uint32_t>(t.triangles.size());
   bstl.append(reinterpret_cast<const char*>(&nf), 4);
   for (const auto& v : t.vertices)
@@ -206,17 +209,17 @@ TEST_CASE("OFF in free format (records running on across lines) reads", "[qualit
 }
 
 TEST_CASE("PLY element counts the file cannot hold are refused at once", "[quality][io][bad][bounded]") {
-  // 10^18 records declared in a file of a hundred bytes: refused from the
+  // 10^15 records declared in a file of a hundred bytes: refused from the
   // header, ASCII and binary alike, before any record is read.
   for (const char* format : {"ascii", "binary_little_endian"}) {
     INFO(format);
     test::TempFile huge("huge.ply", std::string("ply\nformat ") + format +
-                                        " 1.0\nelement vertex 1000000000000000000\nproperty float x\nend_header\n0 0 0\n");
+                                        " 1.0\nelement vertex 1000000000000000\nproperty float x\nend_header\n0 0 0\n");
     try {
       read_surface_mesh(huge.path());
       FAIL("no error");
     } catch (const InputError& e) {
-      CHECK(std::string(e.what()).find("declares 1000000000000000000 records") != std::string::npos);
+      CHECK(std::string(e.what()).find("declares 1000000000000000 records") != std::string::npos);
     }
   }
   // A small valid text PLY with no newline after its last value still reads.
@@ -224,6 +227,34 @@ TEST_CASE("PLY element counts the file cannot hold are refused at once", "[quali
                        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2");
   CHECK(read_surface_mesh(tight.path()).triangles.size() == 1);
+}
+
+TEST_CASE("PLY headers: property types, counts and list lengths checked in every format", "[quality][io][bad]") {
+  const std::string vertices = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string body = "end_header\n0 0 0\n1 0 0\n0 1 0\n";
+  struct Case {
+    std::string header, body, words;
+  };
+  const std::vector<Case> cases = {
+      {vertices.substr(0, 17) + "property flaot x\nproperty float y\nproperty float z\n", body, "unknown PLY property type 'flaot'"},
+      {vertices + "element face 1\nproperty list float int vertex_indices\n", body + "3 0 1 2\n", "integer count type"},
+      {"element vertex 1e19\nproperty float x\n", body, "count of 0 to 2^53"},
+      {"element vertex -3\nproperty float x\n", body, "count of 0 to 2^53"},
+      {vertices + "element face 1\nproperty list uchar int vertex_indices\n", body + "1e19 0 1 2\n", "bad list length"},
+      {vertices + "element face 1\nproperty list uchar int vertex_indices\n", body + "3 0 1 1e300\n", "not an integer"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.header << c.body);
+    test::TempFile ply("bad.ply", "ply\nformat ascii 1.0\n" + c.header + c.body);
+    try {
+      read_surface_mesh(ply.path());
+      FAIL("no error");
+    } catch (const InputError& e) {
+      INFO(e.what());
+      CHECK(std::string(e.what()).find(ply.path()) != std::string::npos);
+      CHECK(std::string(e.what()).find(c.words) != std::string::npos);
+    }
+  }
 }
 
 TEST_CASE("bad mesh files are reported with file and line", "[quality][io][bad]") {

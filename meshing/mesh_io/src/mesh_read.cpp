@@ -46,6 +46,10 @@ Eigen::Vector3d checked_point(double x, double y, double z, const std::string& p
   return p;
 }
 
+// A whole number a mesh can index: finite and below 2^53 in magnitude, so
+// that no cast from double is undefined or loses the value.
+bool is_whole_number(double v) { return std::isfinite(v) && v == std::floor(v) && std::abs(v) <= 9007199254740992.0; }
+
 // Tokens of a text file with the line each came from; '#' starts a comment.
 struct Tokens {
   std::vector<std::string> words;
@@ -66,13 +70,10 @@ struct Tokens {
     if (end != w.c_str() + w.size()) input_error(*path, at, "expected a number, found '" + w + "'");
     return v;
   }
-  // A whole number a mesh can index: finite and below 2^53 in magnitude, so
-  // that no cast from double is undefined or loses the value.
   long integer() {
     const long at = line();
     const double v = number();
-    if (!std::isfinite(v) || v != std::floor(v) || std::abs(v) > 9007199254740992.0)
-      input_error(*path, at, "expected an integer of at most 2^53, found " + words[next - 1]);
+    if (!is_whole_number(v)) input_error(*path, at, "expected an integer of at most 2^53, found " + words[next - 1]);
     return static_cast<long>(v);
   }
   // A count of items that follow: at most the words left in the file.
@@ -188,11 +189,15 @@ SurfaceMesh read_stl(const std::string& path) {
   const std::string data = read_all(path);
   SurfaceMesh mesh;
   VertexMerger merge;
-  const bool ascii = data.compare(0, 5, "solid") == 0 && data.find("facet") != std::string::npos;
+  // A binary STL's 80-byte header may begin with "solid" and hold "facet"
+  // (some writers put the ASCII keyword there): a file whose size is exactly
+  // what its triangle count announces is binary whatever its header says.
+  uint32_t count = 0;
+  if (data.size() >= 84) std::memcpy(&count, data.data() + 80, 4);
+  const bool sized_binary = data.size() >= 84 && data.size() == 84 + 50ull * count;
+  const bool ascii = !sized_binary && data.compare(0, 5, "solid") == 0 && data.find("facet") != std::string::npos;
   if (!ascii) {
     if (data.size() < 84) input_error(path, 0, "binary STL shorter than its 84-byte header");
-    uint32_t count = 0;
-    std::memcpy(&count, data.data() + 80, 4);
     if (data.size() < 84 + 50ull * count)
       input_error(path, 0, "binary STL announces " + std::to_string(count) + " triangles but is too short");
     for (uint32_t f = 0; f < count; ++f) {
@@ -281,7 +286,13 @@ PlyHeader read_ply_header(const std::string& data, const std::string& path) {
       w >> h.format;
     } else if (tag == "element") {
       PlyElement e;
-      w >> e.name >> e.count;
+      std::string count;
+      w >> e.name >> count;
+      char* end = nullptr;
+      const double value = std::strtod(count.c_str(), &end);
+      if (count.empty() || end != count.c_str() + count.size() || !is_whole_number(value) || value < 0)
+        input_error(path, number, "PLY element '" + e.name + "' needs a count of 0 to 2^53, found '" + count + "'");
+      e.count = static_cast<long>(value);
       h.elements.push_back(e);
     } else if (tag == "property") {
       if (h.elements.empty()) input_error(path, number, "property before any element");
@@ -289,6 +300,11 @@ PlyHeader read_ply_header(const std::string& data, const std::string& path) {
       w >> p.type;
       if (p.type == "list") w >> p.count_type >> p.type;
       w >> p.name;
+      // Checked in every format: an ASCII body is read as numbers whatever
+      // the header says, so a wrong type would pass unseen.
+      ply_type_size(p.type, path);
+      if (!p.count_type.empty() && (ply_type_size(p.count_type, path) == 8 || p.count_type.find("float") == 0))
+        input_error(path, number, "PLY list '" + p.name + "' needs an integer count type, not " + p.count_type);
       h.elements.back().properties.push_back(p);
     }
   });
@@ -348,10 +364,15 @@ SurfaceMesh read_ply(const std::string& path) {
       std::vector<long> corners;
       for (const PlyProperty& p : e.properties) {
         if (!p.count_type.empty()) {
-          const long n = static_cast<long>(values.next(p.count_type));
-          for (long k = 0; k < n; ++k) {
+          const double count = values.next(p.count_type);
+          if (!is_whole_number(count) || count < 0)
+            input_error(path, 0, "PLY " + e.name + " " + std::to_string(i) + ": bad list length");
+          const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+          for (long k = 0; k < static_cast<long>(count); ++k) {
             const double v = values.next(p.type);
-            if (e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index")) corners.push_back(static_cast<long>(v));
+            if (!indices) continue;
+            if (!is_whole_number(v)) input_error(path, 0, "PLY face " + std::to_string(i) + ": vertex index is not an integer");
+            corners.push_back(static_cast<long>(v));
           }
         } else {
           const double v = values.next(p.type);
