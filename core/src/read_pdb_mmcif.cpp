@@ -11,6 +11,7 @@
 #include <gemmi/mmcif.hpp>
 #include <gemmi/pdb.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <map>
 #include <utility>
@@ -68,6 +69,18 @@ PdbPrepass prepass_pdb(const std::string& path, const std::string& text) {
     if (end == std::string::npos) end = text.size();
     std::string line = text.substr(start, end - start);
     ++line_number;
+    // PDB is ASCII. gemmi compares record and residue names through int
+    // shifts that a byte above 0x7f makes undefined, and it reads a long
+    // line as several, so such a byte anywhere may reach a record name: in
+    // the names of an atom record it is an error, elsewhere it becomes '?'.
+    const bool atom_record = line.compare(0, 6, "ATOM  ") == 0 || line.compare(0, 6, "HETATM") == 0;
+    for (size_t i = 0; i < line.size(); ++i) {
+      if (static_cast<unsigned char>(line[i]) <= 0x7f) continue;
+      if (atom_record && i < 27)
+        input_error(path, line_number, "a byte that is not ASCII in column " + std::to_string(i + 1) +
+                                           " (atom and residue names are ASCII in PDB)");
+      line[i] = '?';
+    }
     if (line.compare(0, 5, "MODEL") == 0) {
       if (seen_model_record) ++model;
       seen_model_record = true;
@@ -116,6 +129,12 @@ void check_atom_site_columns(gemmi::cif::Document& doc, const std::string& path)
       if (!block.has_tag(tag))
         input_error(path, 0, std::string("data block '") + block.name + "': the _atom_site table has no " + tag +
                                  " column");
+    // Residue names go through gemmi's int-shift comparisons (as in PDB).
+    for (const char* tag : {"_atom_site.label_comp_id", "_atom_site.auth_comp_id"})
+      for (const std::string& value : block.find_values(tag))
+        if (std::any_of(value.begin(), value.end(), [](char c) { return static_cast<unsigned char>(c) > 0x7f; }))
+          input_error(path, 0, std::string("data block '") + block.name + "': a residue name in " + tag +
+                                   " is not ASCII");
   }
 }
 
