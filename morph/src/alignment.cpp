@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <map>
 #include <tuple>
 #include <utility>
@@ -12,9 +13,15 @@
 namespace skinmesh {
 namespace {
 
-using AtomKey = std::tuple<std::string, int, char, std::string>;  // chain, residue number, insertion code, name
+// chain, residue number, insertion code, residue name, atom name: without the
+// residue name the backbone atoms of any two proteins numbered alike match.
+using AtomKey = std::tuple<std::string, int, char, std::string, std::string>;
 
-AtomKey key_of(const Atom& a) { return {a.chain, a.residue_number, a.insertion_code, a.name}; }
+AtomKey key_of(const Atom& a) { return {a.chain, a.residue_number, a.insertion_code, a.residue, a.name}; }
+
+// `automatic` takes two sides for one molecule (two conformations) when this
+// share of the smaller side's atoms match; otherwise the match is chance.
+constexpr double kSameMolecule = 0.9;
 
 // Pairs (source position, target position) of the atoms both have, each key
 // once (a key seen twice on a side is ambiguous and left out).
@@ -77,7 +84,9 @@ Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod 
   if (method == AlignmentMethod::none) return out;
   if (method == AlignmentMethod::kabsch || method == AlignmentMethod::automatic) {
     const auto pairs = matched_atoms(source, target);
-    if (pairs.size() >= 3) return kabsch(pairs);
+    const double smaller = static_cast<double>(std::min(source.atoms.size(), target.atoms.size()));
+    const bool same_molecule = static_cast<double>(pairs.size()) >= kSameMolecule * smaller;
+    if (pairs.size() >= 3 && (method == AlignmentMethod::kabsch || same_molecule)) return kabsch(pairs);
     if (method == AlignmentMethod::kabsch)
       contract_error("Kabsch alignment needs at least three atoms matched by chain, residue and name; " +
                      std::to_string(pairs.size()) + " match");

@@ -90,6 +90,16 @@ TEST_CASE("alignment: Kabsch recovers a rigid motion, centroid otherwise", "[mor
   CHECK_THROWS_AS(align(source, other, AlignmentMethod::kabsch), ContractError);
   CHECK(align(source, other, AlignmentMethod::none).motion.translation.norm() == 0.0);
 
+  // Two proteins numbered alike (ubiquitin, HIV protease chain A): their
+  // backbone atoms share chain, number and name, some residues even their
+  // type, but they are not one molecule.
+  const Molecule protease = read_molecule(test::data_file("1hpv.pdb"));
+  const Alignment unrelated = align(source, protease, AlignmentMethod::automatic);
+  CHECK(unrelated.used == AlignmentMethod::centroid);
+  const Alignment forced = align(source, protease, AlignmentMethod::kabsch);
+  CHECK(forced.used == AlignmentMethod::kabsch);
+  CHECK(forced.matched < static_cast<long>(source.atoms.size()) / 2);
+
   // Two models of one NMR ensemble: every heavy atom matches, and the fit is
   // a real one (not zero: the models differ).
   const auto models = read_all_models(test::data_file("2k39_3models.pdb"));

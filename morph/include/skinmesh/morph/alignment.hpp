@@ -10,7 +10,7 @@
 namespace skinmesh {
 
 enum class AlignmentMethod {
-  automatic,  // Kabsch when at least three atoms match (the same molecule), centroid otherwise
+  automatic,  // Kabsch when 90% of the smaller side's atoms match (one molecule, two conformations), else centroid
   none,       // as read
   centroid,   // the target's centroid onto the source's
   kabsch,     // the rigid motion of least RMSD over matched atoms (Kabsch 1976, with the reflection excluded)
@@ -26,7 +26,7 @@ struct RigidMotion {
 struct Alignment {
   AlignmentMethod used = AlignmentMethod::none;  // never automatic
   RigidMotion motion;  // maps the target's coordinates into the source's frame
-  long matched = 0;    // atoms matched by chain, residue number, insertion code and atom name (Kabsch)
+  long matched = 0;    // atoms matched by chain, residue number, insertion code, residue and atom name (Kabsch)
   double rmsd = 0.0;   // Angstrom over the matched atoms after the motion (Kabsch)
 };
 
