@@ -112,6 +112,7 @@ MorphOptions morph_options(const MorphCommandOptions& o) {
 struct Sides {
   Molecule source, target;  // the target moved into the source's frame
   Alignment alignment;
+  long unmoved = 0;  // target atoms put exactly on their source atom (snap_unmoved)
   std::vector<Ball> source_balls, target_balls;
 };
 
@@ -130,6 +131,7 @@ Sides read_sides(const MorphCommandOptions& o) {
                                                        {"kabsch", AlignmentMethod::kabsch}};
   s.alignment = align(s.source, s.target, methods.at(o.align));
   s.target = moved(std::move(s.target), s.alignment.motion);
+  s.unmoved = snap_unmoved(s.source, s.target);
   s.source_balls = balls_from_molecule(s.source, o.molecule.shrink, o.molecule.convention());
   s.target_balls = balls_from_molecule(s.target, o.molecule.shrink, o.molecule.convention());
   return s;
@@ -279,7 +281,7 @@ void write_pvd(std::ostream& out, const std::vector<double>& times) {
   out << "</Collection>\n</VTKFile>\n";
 }
 
-json alignment_json(const Alignment& a) {
+json alignment_json(const Alignment& a, long unmoved) {
   json rotation = json::array();
   for (int r = 0; r < 3; ++r)
     rotation.push_back({a.motion.rotation(r, 0), a.motion.rotation(r, 1), a.motion.rotation(r, 2)});
@@ -288,7 +290,9 @@ json alignment_json(const Alignment& a) {
           {"rmsd", a.rmsd},
           {"rotation", rotation},
           {"translation", {a.motion.translation[0], a.motion.translation[1], a.motion.translation[2]}},
-          {"maps", "target coordinates into the source's frame: x' = rotation x + translation"}};
+          {"maps", "target coordinates into the source's frame: x' = rotation x + translation"},
+          {"unmoved_atoms", unmoved},
+          {"unmoved_means", "matched target atoms within 1e-9 A of their source atom after the motion, put exactly on it"}};
 }
 
 // source.xyzr / target.xyzr (or .wpts when that side was read as weighted
@@ -328,7 +332,7 @@ json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& m
           {"weights", convention_name(o.molecule.convention())},
           {"ball_sets", "B(t) = {(1-t) a_i + t b_j}, weight (1-t) w_i + t w_j - t(1-t)|z_i - z_j|^2 "
                         "(docs/math.md section 4); live pairs " + std::to_string(morph.pairs().size())},
-          {"alignment", alignment_json(sides.alignment)},
+          {"alignment", alignment_json(sides.alignment, sides.unmoved)},
           {"frame_times", t},
           {"topology_events", events},
           {"min_angle", options.frames.min_angle},
@@ -347,6 +351,9 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
                       ? " on " + std::to_string(sides.alignment.matched) + " matched atoms, RMSD " +
                             std::to_string(sides.alignment.rmsd) + " A"
                       : std::string())
+              << (sides.unmoved > 0 ? "; " + std::to_string(sides.unmoved) +
+                                          " atoms within 1e-9 A of their source atom put exactly on it"
+                                    : std::string())
               << "\n";
   OutputDirectory dir(o.directory);
   OutputSet outputs;

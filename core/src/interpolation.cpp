@@ -5,6 +5,8 @@
 #include "regular_triangulation.hpp"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <deque>
 #include <set>
 #include <stdexcept>
@@ -46,6 +48,21 @@ struct PowerDiagram {
   }
 };
 
+// Per ball of `of`: the index of a ball of `in` with the same centre and
+// weight, bit for bit, or -1.
+std::vector<int> twins(const std::vector<Ball>& of, const std::vector<Ball>& in) {
+  using Key = std::array<double, 4>;
+  std::map<Key, int> index;
+  for (size_t k = 0; k < in.size(); ++k)
+    index.emplace(Key{in[k].center[0], in[k].center[1], in[k].center[2], in[k].weight}, static_cast<int>(k));
+  std::vector<int> out(of.size(), -1);
+  for (size_t k = 0; k < of.size(); ++k) {
+    const auto it = index.find(Key{of[k].center[0], of[k].center[1], of[k].center[2], of[k].weight});
+    if (it != index.end()) out[k] = it->second;
+  }
+  return out;
+}
+
 }  // namespace
 
 Ball interpolate_ball(const Ball& a, const Ball& b, double t) {
@@ -73,6 +90,20 @@ std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vec
   // inserted so far is hidden among all of them, so it is dead for good;
   // one inserted alive may be hidden later, and the triangulation's
   // vertices at the end are the live set.
+  // Atoms that do not move: when a_i equals b_i' and b_j equals a_j', then
+  // for every t, b_ij(t) = (1-t) b_ii'(t) + t b_j'j(t) (b_ii'(t) = a_i and
+  // b_j'j(t) = b_j), a convex combination of two balls of B(t): it lies in
+  // conv B(t) and changes no skin (docs/math.md section 4), and its overlay
+  // cell, a piece of the facet the two identical diagrams share, has no
+  // volume. Kept, such balls made B(t) so degenerate that the mesher's
+  // refinement stalled (a molecule morphed onto itself). They are left out
+  // and not walked through: the cells with volume are connected by facets
+  // among themselves.
+  const std::vector<int> source_twin = twins(source, target), target_twin = twins(target, source);
+  auto redundant = [&](const BallPair& p) {
+    const int i2 = source_twin[static_cast<size_t>(p.source)], j2 = target_twin[static_cast<size_t>(p.target)];
+    return i2 >= 0 && j2 >= 0 && i2 != p.target;
+  };
   Regular overlay;
   std::unordered_set<long> seen;
   std::deque<BallPair> queue;
@@ -85,6 +116,7 @@ std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vec
   while (!queue.empty()) {
     const BallPair p = queue.front();
     queue.pop_front();
+    if (redundant(p)) continue;
     const Ball mid = interpolate_ball(source[static_cast<size_t>(p.source)], target[static_cast<size_t>(p.target)], 0.5);
     const auto v = overlay.insert(weighted(mid));
     if (v == Regular::Vertex_handle()) continue;  // hidden

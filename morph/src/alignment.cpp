@@ -23,23 +23,32 @@ AtomKey key_of(const Atom& a) { return {a.chain, a.residue_number, a.insertion_c
 // share of the smaller side's atoms match; otherwise the match is chance.
 constexpr double kSameMolecule = 0.9;
 
-// Pairs (source position, target position) of the atoms both have, each key
-// once (a key seen twice on a side is ambiguous and left out).
-std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> matched_atoms(const Molecule& source, const Molecule& target) {
-  std::map<AtomKey, std::pair<int, Eigen::Vector3d>> in_source;
-  for (const Atom& a : source.atoms) {
-    auto [it, fresh] = in_source.try_emplace(key_of(a), 1, a.position);
+// Pairs (source index, target index) of the atoms both have, each key once
+// (a key seen twice on a side is ambiguous and left out).
+std::vector<std::pair<size_t, size_t>> matched_atoms(const Molecule& source, const Molecule& target) {
+  std::map<AtomKey, std::pair<int, size_t>> in_source;  // times seen, index
+  for (size_t k = 0; k < source.atoms.size(); ++k) {
+    auto [it, fresh] = in_source.try_emplace(key_of(source.atoms[k]), 1, k);
     if (!fresh) ++it->second.first;
   }
   std::map<AtomKey, int> seen_in_target;
   for (const Atom& b : target.atoms) ++seen_in_target[key_of(b)];
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs;
-  for (const Atom& b : target.atoms) {
-    const auto it = in_source.find(key_of(b));
-    if (it != in_source.end() && it->second.first == 1 && seen_in_target[key_of(b)] == 1)
-      pairs.emplace_back(it->second.second, b.position);
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (size_t k = 0; k < target.atoms.size(); ++k) {
+    const AtomKey key = key_of(target.atoms[k]);
+    const auto it = in_source.find(key);
+    if (it != in_source.end() && it->second.first == 1 && seen_in_target[key] == 1)
+      pairs.emplace_back(it->second.second, k);
   }
   return pairs;
+}
+
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> matched_positions(const Molecule& source,
+                                                                           const Molecule& target) {
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> out;
+  for (const auto& [i, j] : matched_atoms(source, target))
+    out.emplace_back(source.atoms[i].position, target.atoms[j].position);
+  return out;
 }
 
 Eigen::Vector3d centroid(const std::vector<Atom>& atoms) {
@@ -83,7 +92,7 @@ Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod 
   Alignment out;
   if (method == AlignmentMethod::none) return out;
   if (method == AlignmentMethod::kabsch || method == AlignmentMethod::automatic) {
-    const auto pairs = matched_atoms(source, target);
+    const auto pairs = matched_positions(source, target);
     const double smaller = static_cast<double>(std::min(source.atoms.size(), target.atoms.size()));
     const bool same_molecule = static_cast<double>(pairs.size()) >= kSameMolecule * smaller;
     if (pairs.size() >= 3 && (method == AlignmentMethod::kabsch || same_molecule)) return kabsch(pairs);
@@ -99,6 +108,19 @@ Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod 
 Molecule moved(Molecule molecule, const RigidMotion& motion) {
   for (Atom& a : molecule.atoms) a.position = motion.apply(a.position);
   return molecule;
+}
+
+long snap_unmoved(const Molecule& source, Molecule& target, double within) {
+  long snapped = 0;
+  for (const auto& [i, j] : matched_atoms(source, target)) {
+    const Eigen::Vector3d& a = source.atoms[i].position;
+    Eigen::Vector3d& b = target.atoms[j].position;
+    if ((b - a).norm() <= within) {
+      b = a;
+      ++snapped;
+    }
+  }
+  return snapped;
 }
 
 }  // namespace skinmesh

@@ -272,10 +272,9 @@ TEST_CASE("skinmesh interpolate writes the live pairs of B(t) as weighted points
 TEST_CASE("numeric options refuse NaN and infinities when parsed", "[cli][bad]") {
   const std::string pept = skinmesh::test::data_file("pept.pdb");
   skinmesh::test::TempFile out("never.ply");
-  for (const std::string& bad : {"--epsilon nan", "--tolerance inf", "--min-angle nan", "--edge-length -inf",
-                                 "--shrink nan"}) {
+  for (const char* bad : {"--epsilon nan", "--tolerance inf", "--min-angle nan", "--edge-length -inf", "--shrink nan"}) {
     INFO(bad);
-    const Run r = run("--quiet mesh " + pept + " -o " + out.path() + " " + bad);
+    const Run r = run("--quiet mesh " + pept + " -o " + out.path() + " " + std::string(bad));
     CHECK(r.code != 0);
     CHECK(r.output.find("finite") != std::string::npos);
   }
@@ -395,6 +394,15 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
     CHECK(written[i].center == original[i].center);
     CHECK(written[i].weight == original[i].weight);
   }
+  // A molecule onto itself: the Kabsch fit leaves every atom within
+  // rounding of itself; they are put exactly on their source atoms, and
+  // every frame is the molecule's own skin.
+  const std::string itself = std::string(pattern) + "/itself";
+  const Run same = run("--quiet morph " + file + " " + file + " --frames 3 -o " + itself);
+  INFO(same.output);
+  REQUIRE(same.code == 0);
+  std::ifstream itself_json(itself + "/morph.json");
+  CHECK(nlohmann::json::parse(itself_json)["alignment"]["unmoved_atoms"] == 78);
   // Bad requests: nothing written, non-zero exit.
   const std::string second = std::string(pattern) + "/second";
   const Run backwards = run("morph " + file + " " + file + " --t 0.5,0.2 -o " + second);

@@ -90,6 +90,14 @@ TEST_CASE("live pairs are the non-hidden balls of the full m*n set", "[interpola
     REQUIRE(b.certified);
     CHECK(std::abs(a.value - b.value) <= 1e-9 * std::max(1.0, std::abs(b.value)));
   }
-  // An atom that does not move pairs with itself.
+  // An atom that does not move pairs with itself, and two that do not move
+  // (i, j not multiples of 9) never pair with each other.
   CHECK(std::binary_search(partial.begin(), partial.end(), BallPair{1, 1}));
+  for (const BallPair& p : partial)
+    if (p.source % 9 != 0 && p.target % 9 != 0) CHECK(p.source == p.target);
+  // A set onto itself: each of its non-hidden balls with itself, nothing else.
+  std::vector<BallPair> own;
+  for (const BallPair& p : non_hidden_of_all_pairs(m1, m1))
+    if (p.source == p.target) own.push_back(p);
+  CHECK(live_pairs(m1, m1) == own);
 }

@@ -78,6 +78,16 @@ TEST_CASE("alignment: Kabsch recovers a rigid motion, centroid otherwise", "[mor
   for (size_t i = 0; i < source.atoms.size(); i += 37)
     CHECK((k.motion.apply(target.atoms[i].position) - source.atoms[i].position).norm() <= 1e-9);
   CHECK(k.motion.rotation.determinant() == Approx(1.0));
+  // After the fit every atom is within rounding of its source atom, not on
+  // it; snap_unmoved puts them there, and only them.
+  Molecule fitted = moved(target, k.motion);
+  fitted.atoms[5].position += Eigen::Vector3d(0, 0, 1e-6);
+  long off = 0;
+  for (size_t i = 0; i < source.atoms.size(); ++i) off += fitted.atoms[i].position != source.atoms[i].position;
+  CHECK(off > 0);
+  CHECK(snap_unmoved(source, fitted) == static_cast<long>(source.atoms.size()) - 1);
+  for (size_t i = 0; i < source.atoms.size(); ++i)
+    CHECK((fitted.atoms[i].position == source.atoms[i].position) == (i != 5));
 
   // Two different molecules share no atom keys: the centroids are matched.
   const Molecule other = read_molecule(test::data_file("pept.pdb"));

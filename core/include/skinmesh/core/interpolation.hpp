@@ -28,10 +28,13 @@ std::vector<BallPair> all_pairs(size_t m, size_t n);
 // regular triangulation (its power diagram is the overlay of the two, docs/math.md
 // section 4), about m + n of them. Found by a walk over the overlay from the
 // pairs holding the balls' centres, each candidate tested by insertion into
-// the regular triangulation of B(1/2). Sorted. A pair whose overlay cell has
-// no volume (atoms that stay put make the two diagrams share facets) may be
-// kept or dropped, as CGAL's symbolic perturbation decides; either way the
-// skin is the same.
+// the regular triangulation of B(1/2). Sorted. Atoms that stay put make the
+// two diagrams share facets, and pairs across a shared facet have overlay
+// cells of no volume: a pair of two atoms that both stay put (a_i equal to
+// some target ball, b_j to some source ball, a_i != b_j) is left out, since
+// its ball is a convex combination of two others for every t; any other
+// pair of zero volume is kept or dropped as CGAL's symbolic perturbation
+// decides. Either way the skin of B(t) is the same.
 std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target);
 
 // Moves the balls so that the mean of their centres is the origin (morphs

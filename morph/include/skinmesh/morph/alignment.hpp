@@ -36,4 +36,12 @@ Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod 
 // The target with the motion applied to every atom.
 Molecule moved(Molecule molecule, const RigidMotion& motion);
 
+// Puts every target atom that lies within `within` (Angstrom) of its matched
+// source atom (chain, residue number, insertion code, residue and atom name)
+// exactly on it; returns how many. A fit of two identical conformations
+// leaves them about 1e-14 A apart, and balls that near make B(t) degenerate
+// by rounding alone: the pairs of two unmoved atoms are left out of a morph
+// only when the atoms are the same bit for bit (interpolation.hpp).
+long snap_unmoved(const Molecule& source, Molecule& target, double within = 1e-9);
+
 }  // namespace skinmesh
