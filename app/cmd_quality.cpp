@@ -68,8 +68,8 @@ void grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, cons
   json report = to_json(q);
   report["file"] = o.mesh;
   if (o.tetgen) {
-    const long pairs = tetgen_self_intersections(mesh);
-    report["tetgen_self_intersecting_pairs"] = pairs >= 0 ? json(pairs) : json(nullptr);
+    const long triangles = tetgen_self_intersections(mesh);
+    report["tetgen_self_intersecting_triangles"] = triangles >= 0 ? json(triangles) : json(nullptr);
   }
   if (!o.molecule.path.empty()) {
     const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
@@ -86,11 +86,11 @@ void grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, cons
     return;
   }
   print_quality_summary(std::cout, o.mesh, q);
-  if (report.contains("tetgen_self_intersecting_pairs"))
+  if (report.contains("tetgen_self_intersecting_triangles"))
     std::cout << "  TetGen -d:   "
-              << (report["tetgen_self_intersecting_pairs"].is_null()
-                      ? std::string("could not be run")
-                      : std::to_string(report["tetgen_self_intersecting_pairs"].get<long>()) + " intersecting pairs")
+              << (report["tetgen_self_intersecting_triangles"].is_null()
+                      ? std::string("TetGen stopped with an error")
+                      : std::to_string(report["tetgen_self_intersecting_triangles"].get<long>()) + " triangles meet another")
               << "\n";
   if (report.contains("on_surface_error"))
     std::cout << "  on-surface error: max " << report["on_surface_error"]["max"].get<double>() << " A, mean "

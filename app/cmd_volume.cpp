@@ -53,6 +53,10 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
   cmd.add_option("--max-volume", o.volume.max_volume, "largest tetrahedron, A^3 (0: no bound)")
       ->check(finite_number())->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd.add_option("--max-tetrahedra", o.volume.max_tetrahedra,
+                 "refuse a --max-volume that asks for more tetrahedra than this (domain volume / max volume)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd.add_flag("--drop-cavities", o.drop_cavities, "fill enclosed voids instead of keeping their surfaces");
   cmd.add_option("--epsilon", o.meshing.sizing.epsilon, "surface: edge length / local radius of curvature")
       ->check(finite_number())->check(CLI::PositiveNumber)
@@ -70,13 +74,13 @@ VolumeOptions volume_options(const VolumeCommandOptions& o) {
 }
 
 json volume_report(const VolumeCommandOptions& o, const VolumeOptions& volume, const VolumeMeshResult& made,
-                   const TetQuality& q, const MeshQuality& sq, long tetgen_pairs) {
+                   const TetQuality& q, const MeshQuality& sq, long tetgen_triangles) {
   json report = tet_report(made.mesh, q);
   report["molecule"] = o.molecule.path;
   report["domain"] = o.domain;
   report["surface"] = to_json(sq);
   report["surface_self_intersections"] = {{"cgal_exact", sq.self_intersecting_pairs},
-                                          {"tetgen", tetgen_pairs >= 0 ? json(tetgen_pairs) : json(nullptr)}};
+                                          {"tetgen_triangles", tetgen_triangles >= 0 ? json(tetgen_triangles) : json(nullptr)}};
   // The interior's tetrahedra fill exactly what the skin encloses (its
   // outer components minus kept cavities): the grader's signed volume.
   report["enclosed_volume"] = sq.volume;
@@ -101,7 +105,7 @@ void print_volume_summary(const VolumeCommandOptions& o, const VolumeOptions& vo
                           const json& report) {
   const json& smoothing = report["smoothing"];
   const json& surface = report["surface"];
-  const json& tetgen = report["surface_self_intersections"]["tetgen"];
+  const json& tetgen = report["surface_self_intersections"]["tetgen_triangles"];
   std::cout << o.output << ".{vtu,msh,node,ele,face}: " << q.tets << " tetrahedra, " << q.points << " points ("
             << o.domain << ")\n";
   print_tet_quality(std::cout, q);
@@ -115,7 +119,7 @@ void print_volume_summary(const VolumeCommandOptions& o, const VolumeOptions& vo
               << r["volume"].get<double>() << " A^3\n";
   std::cout << "  skin: " << surface["triangles"] << " triangles, closed oriented manifold, "
             << surface["self_intersecting_pairs"] << " self-intersecting pairs (CGAL, exact), "
-            << (tetgen.is_null() ? std::string("not checked") : tetgen.dump()) << " (TetGen -d); encloses "
+            << (tetgen.is_null() ? std::string("not checked") : tetgen.dump() + " triangles") << " (TetGen -d); encloses "
             << report["enclosed_volume"].get<double>() << " A^3\n";
 }
 
@@ -152,8 +156,8 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
     return ExitCode::not_met;
   }
   const TetQuality q = grade_tet_mesh(made.mesh);
-  const long tetgen_pairs = tetgen_self_intersections(surface.mesh, volume.tetgen);
-  const json report = volume_report(o, volume, made, q, g.quality, tetgen_pairs);
+  const long tetgen_triangles = tetgen_self_intersections(surface.mesh);
+  const json report = volume_report(o, volume, made, q, g.quality, tetgen_triangles);
   OutputSet outputs;
   outputs.add(o.output + ".vtu", [&](std::ostream& out) { write_vtu(out, made.mesh); });
   outputs.add(o.output + ".msh", [&](std::ostream& out) { write_gmsh(out, made.mesh); });

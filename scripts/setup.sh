@@ -11,7 +11,7 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev   # regular triangulation, exact predicates, Skin_surface_3
   libeigen3-dev                                     # small dense linear algebra
   libopenmesh-dev                                   # surface mesh and local edits
-  tetgen                                            # volume meshes, self-intersection check
+  libtet1.5-dev                                     # TetGen library: volume meshes, self-intersection check
   catch2                                            # tests (v2)
   gemmi-dev tao-pegtl-dev zlib1g-dev                # PDB/mmCIF input (gemmi's cif.hpp needs PEGTL)
   libtbb-dev                                        # threads

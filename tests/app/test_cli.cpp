@@ -228,7 +228,7 @@ TEST_CASE("skinmesh volume writes VTU, Gmsh and TetGen files with a report", "[c
   CHECK(j["surface"]["closed"] == true);
   CHECK(j["surface"]["manifold"] == true);
   CHECK(j["surface_self_intersections"]["cgal_exact"] == 0);
-  CHECK(j["surface_self_intersections"]["tetgen"] == 0);
+  CHECK(j["surface_self_intersections"]["tetgen_triangles"] == 0);
   CHECK(j["bounds_met"] == true);
   CHECK(j["max_radius_edge_ratio"].get<double>() <= 2.0);
   CHECK(j["min_dihedral_deg"].get<double>() >= 5.0);
@@ -238,6 +238,15 @@ TEST_CASE("skinmesh volume writes VTU, Gmsh and TetGen files with a report", "[c
   CHECK(bad.code != 0);
   std::ifstream none(stem + ".vtu");
   CHECK(!none.good());
+
+  // A volume bound past the tetrahedron budget (1,335 A^3 / 1e-4 A^3 is
+  // 13 million) is refused before TetGen runs, naming what would fit.
+  const std::string tiny_stem = stem + "-tiny";
+  const Run tiny = run("volume " + skinmesh::test::data_file("pept.pdb") + " -o " + tiny_stem + " --max-volume 0.0001");
+  INFO(tiny.output);
+  CHECK(tiny.code == 3);
+  CHECK(tiny.output.find("--max-volume of at least") != std::string::npos);
+  for (const char* ext : {".vtu", ".msh", ".node", ".ele", ".face"}) CHECK(!std::ifstream(tiny_stem + ext).good());
 }
 
 TEST_CASE("skinmesh interpolate writes the live pairs of B(t) as weighted points", "[cli][interpolation]") {

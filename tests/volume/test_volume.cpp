@@ -314,3 +314,37 @@ TEST_CASE("self-intersections: CGAL's exact check and TetGen's agree", "[volume]
   CHECK(count_self_intersections(skin) == 0);
   CHECK(tetgen_self_intersections(skin) == 0);
 }
+
+TEST_CASE("TetGen runs in memory: its errors and an oversized volume bound are statuses", "[volume][bad]") {
+  // Two closed tetrahedra that pass through each other: closed, manifold and
+  // oriented, so TetGen gets them and stops (it throws in library builds).
+  const VolumeMeshResult crossing = tetrahedralize(test::two_interpenetrating_tetrahedra());
+  INFO(crossing.message);
+  CHECK(crossing.status == VolumeStatus::tetgen_failed);
+  CHECK(crossing.message.find("TetGen") != std::string::npos);
+  CHECK(crossing.mesh.tets.empty());
+  // TetGen's -d check: the triangles that meet another (one tetrahedron's
+  // face and three faces of the other meet, as CGAL's 3 pairs say).
+  CHECK(tetgen_self_intersections(test::two_interpenetrating_tetrahedra()) >= 2);
+
+  // A volume bound that asks for more tetrahedra than the budget is refused
+  // before TetGen runs, naming the bound that would fit, which then runs.
+  const SurfaceMesh skin = skin_mesh(test::data_file("pept.pdb"));
+  VolumeOptions tiny;
+  tiny.max_volume = 0.05;
+  tiny.max_tetrahedra = 20'000;
+  const VolumeMeshResult refused = tetrahedralize(skin, tiny);
+  INFO(refused.message);
+  REQUIRE(refused.status == VolumeStatus::over_budget);
+  CHECK(refused.mesh.tets.empty());
+  const size_t at = refused.message.find("--max-volume of at least ");
+  REQUIRE(at != std::string::npos);
+  VolumeOptions fits = tiny;
+  fits.max_volume = 1.01 * std::stod(refused.message.substr(at + 25));
+  const VolumeMeshResult made = tetrahedralize(skin, fits);
+  INFO(made.message);
+  REQUIRE(made.status == VolumeStatus::ok);
+  // The estimate is a lower bound: TetGen made at least that many.
+  const double enclosed = grade_mesh(skin).volume;
+  CHECK(static_cast<double>(made.mesh.tets.size()) >= enclosed / fits.max_volume);
+}

@@ -1,30 +1,32 @@
-// Volume meshing by the TetGen program: the surface (and a box) written as a
-// .smesh piecewise linear complex with facet markers, region points marking
-// the interior, the solvent and cavities, hole points where nothing is to be
-// meshed; `tetgen -pzAYQ -q<ratio>/<dihedral> [-a<volume>]` runs in a
-// temporary directory and its .node/.ele/.face files are read back.
+// Volume meshing by TetGen's library (Debian's libtet1.5-dev), in memory:
+// the surface (and a box) handed over as a piecewise linear complex with
+// facet markers, region points marking the interior, the solvent and
+// cavities, hole points where nothing is to be meshed; TetGen runs with
+// `pzAYQ q<ratio>/<dihedral> [a<volume>]` and its tetrahedra, regions and
+// marked boundary faces are read from its output structure. No shell, no
+// temporary files; TetGen's errors (it throws an int in library builds)
+// become statuses with a message.
 #include "skinmesh/volume/volume_mesh.hpp"
 
 #include "skinmesh/core/error.hpp"
-#include "skinmesh/core/number_text.hpp"
-#include "skinmesh/mesh_io/mesh_read.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 #include "skinmesh/quality/tet_quality.hpp"
+
+#include "tetgen_run.hpp"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
-#include <unistd.h>
+#include <vector>
 
 namespace skinmesh {
 namespace {
+
+using detail::Plc;
 
 constexpr double kTetgenTightening = 0.8;
 
@@ -80,66 +82,42 @@ std::optional<Eigen::Vector3d> point_beside(const SurfaceMesh& mesh, const std::
   return std::nullopt;
 }
 
-struct Marked {
-  Eigen::Vector3d point;
-  int region;
-};
-
-// What TetGen meshes: a piecewise linear complex of marked triangles, with
-// hole points (nothing meshed around them) and region points.
-struct Plc {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<std::array<int, 3>> facets;
-  std::vector<int> markers;  // kFace* per facet
-  std::vector<Eigen::Vector3d> holes;
-  std::vector<Marked> regions;
-};
-
-// A TetGen .smesh: points, triangles with markers, hole points, region points.
-void write_smesh(std::ostream& out, const Plc& plc) {
-  auto xyz = [](const Eigen::Vector3d& p) {
-    return exact_number_text(p[0]) + ' ' + exact_number_text(p[1]) + ' ' + exact_number_text(p[2]);
-  };
-  out << plc.points.size() << " 3 0 0\n";
-  for (size_t i = 0; i < plc.points.size(); ++i) out << i << ' ' << xyz(plc.points[i]) << '\n';
-  out << plc.facets.size() << " 1\n";
-  for (size_t f = 0; f < plc.facets.size(); ++f)
-    out << "3 " << plc.facets[f][0] << ' ' << plc.facets[f][1] << ' ' << plc.facets[f][2] << ' ' << plc.markers[f]
-        << '\n';
-  out << plc.holes.size() << '\n';
-  for (size_t h = 0; h < plc.holes.size(); ++h) out << h << ' ' << xyz(plc.holes[h]) << '\n';
-  out << plc.regions.size() << '\n';
-  for (size_t r = 0; r < plc.regions.size(); ++r)
-    out << r << ' ' << xyz(plc.regions[r].point) << ' ' << plc.regions[r].region << " -1\n";
-}
-
-std::string read_tail(const std::string& path) {
-  std::ifstream in(path);
-  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return all.size() > 600 ? all.substr(all.size() - 600) : all;
-}
-
-// TetGen's working directory, removed with its files. path is empty when it
-// could not be made.
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char pattern[] = "/tmp/skinmesh-tetgen-XXXXXX";
-    if (mkdtemp(pattern)) path = pattern;
-  }
-  ~TempDir() {
-    for (const char* ext : {".smesh", ".1.node", ".1.ele", ".1.face", ".1.edge", ".1.smesh", ".log"})
-      std::remove((path + "/plc" + ext).c_str());
-    if (!path.empty()) ::rmdir(path.c_str());
-  }
-};
-
 void check_options(const VolumeOptions& options) {
   if (!(options.bounds.max_radius_edge >= 1.0)) contract_error("the radius-edge bound must be at least 1");
   if (!(options.bounds.min_dihedral >= 0 && options.bounds.min_dihedral < 70))
     contract_error("the dihedral bound must be in [0, 70) degrees");
   if (!(options.max_volume >= 0)) contract_error("the volume bound must be >= 0");
   if (!(options.box_margin > 0)) contract_error("the box margin must be positive");
+  if (!(options.max_tetrahedra > 0)) contract_error("the tetrahedron budget must be positive");
+}
+
+// The volume TetGen fills (Angstrom^3): what the skin encloses, the box
+// (the surface's bounding box grown by the margin, as add_box makes it)
+// less that, or the whole box.
+double domain_volume(const SurfaceMesh& surface, double enclosed, const VolumeOptions& options) {
+  if (options.domain == VolumeDomain::interior) return enclosed;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (const Eigen::Vector3d& p : surface.vertices) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector3d extent = (hi - lo).array() + 2 * options.box_margin;
+  const double box = extent.prod();
+  return options.domain == VolumeDomain::both ? box : box - enclosed;
+}
+
+// A volume bound that asks for more tetrahedra than the budget: the message,
+// with the bound that would fit; empty when it fits.
+std::string over_budget(double volume, const VolumeOptions& options) {
+  if (!(options.max_volume > 0)) return "";
+  const double at_least = volume / options.max_volume;
+  if (at_least <= static_cast<double>(options.max_tetrahedra)) return "";
+  std::ostringstream out;
+  out << "a largest tetrahedron of " << options.max_volume << " A^3 asks for at least " << std::llround(at_least)
+      << " tetrahedra (" << volume << " A^3 to fill), more than the budget of " << options.max_tetrahedra
+      << "; a --max-volume of at least " << volume / static_cast<double>(options.max_tetrahedra)
+      << " A^3 fits (or raise --max-tetrahedra)";
+  return out.str();
 }
 
 // The surface's triangles (less the filled cavities) with their markers, and a
@@ -255,40 +233,25 @@ VolumeMeshResult failed(VolumeStatus status, std::string message) {
 // terminate, so the tightened request stays inside those.
 std::string tetgen_switches(const VolumeOptions& options) {
   std::ostringstream switches;
-  switches << "-pzAYQ -q" << std::max(1.2, kTetgenTightening * options.bounds.max_radius_edge) << '/'
+  switches << "pzAYQq" << std::max(1.2, kTetgenTightening * options.bounds.max_radius_edge) << '/'
            << std::min(options.bounds.min_dihedral + 5.0, 18.0);
-  if (options.max_volume > 0) switches << " -a" << options.max_volume;
+  if (options.max_volume > 0) switches << 'a' << options.max_volume;
   return switches.str();
 }
 
-// Runs TetGen on the complex and reads its tetrahedra back, every one
+// Runs TetGen on the complex and takes its tetrahedra, every one
 // positively oriented.
 VolumeMeshResult run_tetgen(const Plc& plc, const VolumeOptions& options) {
-  TempDir dir;
-  if (dir.path.empty()) return failed(VolumeStatus::tetgen_failed, "cannot create a temporary directory for TetGen");
-  const std::string stem = dir.path + "/plc";
-  {
-    std::ofstream out(stem + ".smesh");
-    write_smesh(out, plc);
-    if (!out) return failed(VolumeStatus::tetgen_failed, "cannot write TetGen's input in " + dir.path);
-  }
-  const std::string command =
-      options.tetgen + ' ' + tetgen_switches(options) + " '" + stem + ".smesh' > '" + stem + ".log' 2>&1";
-  if (std::system(command.c_str()) != 0)
-    return failed(VolumeStatus::tetgen_failed, "TetGen failed (" + command + "): " + read_tail(stem + ".log"));
+  detail::TetgenRun run = detail::run_tetgen(plc, tetgen_switches(options));
+  if (!run.error.empty())
+    return failed(VolumeStatus::tetgen_failed, run.error + " (switches " + tetgen_switches(options) + ")");
   VolumeMeshResult result;
-  try {
-    result.mesh = read_tet_mesh(stem + ".1.ele");
-  } catch (const InputError& e) {
-    return failed(VolumeStatus::tetgen_failed,
-                  std::string("TetGen's output: ") + e.what() + "; " + read_tail(stem + ".log"));
-  }
-  for (auto& t : result.mesh.tets) {
-    const auto& p = result.mesh.points;
+  result.mesh = std::move(run.mesh);
+  const auto& p = result.mesh.points;
+  for (auto& t : result.mesh.tets)
     if (signed_tet_volume(p[static_cast<size_t>(t[0])], p[static_cast<size_t>(t[1])], p[static_cast<size_t>(t[2])],
                           p[static_cast<size_t>(t[3])]) < 0)
       std::swap(t[2], t[3]);
-  }
   return result;
 }
 
@@ -299,6 +262,7 @@ const char* volume_status_name(VolumeStatus status) {
     case VolumeStatus::ok: return "ok";
     case VolumeStatus::surface_not_closed: return "surface_not_closed";
     case VolumeStatus::tetgen_failed: return "tetgen_failed";
+    case VolumeStatus::over_budget: return "over_budget";
   }
   return "unknown";
 }
@@ -317,40 +281,33 @@ VolumeMeshResult tetrahedralize(const SurfaceMesh& surface, const VolumeOptions&
                       " boundary, " + std::to_string(q.nonmanifold_edges) + " non-manifold and " +
                       std::to_string(q.inconsistent_edges) + " inconsistently oriented edges, " +
                       std::to_string(q.nonmanifold_vertices) + " non-manifold vertices)");
+  const std::string too_many = over_budget(domain_volume(surface, q.volume, options), options);
+  if (!too_many.empty()) return failed(VolumeStatus::over_budget, too_many);
   Plc plc;
   const std::string missing = add_surface(surface, options, plc);
   if (!missing.empty()) return failed(VolumeStatus::surface_not_closed, missing);
   if (options.domain != VolumeDomain::interior) add_box(options.box_margin, plc);
   VolumeMeshResult result = run_tetgen(plc, options);
+  // TetGen's commonest input error, named (checked only when it failed).
+  if (result.status == VolumeStatus::tetgen_failed) {
+    const long crossing = count_self_intersections(surface);
+    if (crossing > 0)
+      result.message += "; the surface intersects itself (" + std::to_string(crossing) + " triangle pairs, CGAL exact)";
+  }
   // The few tetrahedra TetGen leaves outside the bounds next to the surface.
   if (result.status == VolumeStatus::ok) result.improvement = improve_tet_mesh(result.mesh, options.bounds);
   return result;
 }
 
-long tetgen_self_intersections(const SurfaceMesh& surface, const std::string& tetgen) {
-  TempDir dir;
-  if (dir.path.empty()) return -1;
-  const std::string stem = dir.path + "/plc";
-  {
-    Plc plc;
-    plc.points = surface.vertices;
-    plc.facets = surface.triangles;
-    plc.markers.assign(surface.triangles.size(), kFaceSkin);
-    std::ofstream out(stem + ".smesh");
-    write_smesh(out, plc);
-    if (!out) return -1;
-  }
-  const std::string command = tetgen + " -dz '" + stem + ".smesh' > '" + stem + ".log' 2>&1";
-  if (std::system(command.c_str()) != 0) return -1;
-  // TetGen says "!! Found N pairs of faces are intersecting." when it finds any.
-  std::ifstream log(stem + ".log");
-  std::string text;
-  while (std::getline(log, text)) {
-    const size_t at = text.find("Found ");
-    if (at != std::string::npos && text.find("intersecting") != std::string::npos)
-      return std::atol(text.c_str() + at + 6);
-  }
-  return 0;
+long tetgen_self_intersections(const SurfaceMesh& surface) {
+  Plc plc;
+  plc.points = surface.vertices;
+  plc.facets = surface.triangles;
+  plc.markers.assign(surface.triangles.size(), kFaceSkin);
+  // -d: TetGen's intersection detection; it hands back the faces that meet
+  // another one as its boundary faces.
+  const detail::TetgenRun run = detail::run_tetgen(plc, "dzQ");
+  return run.error.empty() ? static_cast<long>(run.mesh.faces.size()) : -1;
 }
 
 }  // namespace skinmesh

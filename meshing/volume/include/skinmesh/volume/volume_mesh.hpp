@@ -1,5 +1,5 @@
-// Tetrahedral meshes bounded by a skin mesh, made by the TetGen program
-// (Debian's `tetgen`): the molecule's interior, the solvent between the skin
+// Tetrahedral meshes bounded by a skin mesh, made by TetGen's library
+// (Debian's `libtet1.5-dev`, called in memory): the molecule's interior, the solvent between the skin
 // and a box around it, or both, with region and boundary markers
 // (core/tet_mesh.hpp). The skin's triangles stay as they are (no Steiner
 // points on the surface), so the tet mesh's boundary is the surface mesh
@@ -24,13 +24,17 @@ struct VolumeOptions {
   TetBounds bounds;                // radius-edge (TetGen -q) and dihedral (degrees) bounds
   double max_volume = 0.0;         // Angstrom^3: largest tetrahedron, 0 for no bound (TetGen -a)
   Cavities cavities = Cavities::keep;
-  std::string tetgen = "tetgen";   // the program
+  // Refused up front (status over_budget) when max_volume asks for more
+  // tetrahedra than this: the domain's volume / max_volume is a lower bound
+  // of their number. About 10^7 tetrahedra take TetGen a few GB.
+  long max_tetrahedra = 10'000'000;
 };
 
 enum class VolumeStatus {
   ok,
   surface_not_closed,  // the surface is not a closed, consistently oriented manifold: it bounds no volume
-  tetgen_failed,       // TetGen could not be run, exited with an error, or wrote unreadable output
+  tetgen_failed,       // TetGen stopped with an error (out of memory, self-intersecting input, ...)
+  over_budget,         // max_volume asks for more than max_tetrahedra (nothing run)
 };
 const char* volume_status_name(VolumeStatus status);
 
@@ -47,8 +51,8 @@ struct VolumeMeshResult {
 VolumeMeshResult tetrahedralize(const SurfaceMesh& surface, const VolumeOptions& options = {});
 
 // A second opinion on self-intersections, independent of CGAL: TetGen's -d
-// check of the surface. The number of intersecting triangle pairs, or -1 when
-// TetGen could not be run.
-long tetgen_self_intersections(const SurfaceMesh& surface, const std::string& tetgen = "tetgen");
+// check of the surface. The number of triangles that meet another one (0
+// when none do), or -1 when TetGen stopped with an error.
+long tetgen_self_intersections(const SurfaceMesh& surface);
 
 }  // namespace skinmesh
