@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 namespace skinmesh {
 namespace {
@@ -17,10 +18,11 @@ namespace {
 std::string read_all(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) input_error(path, 0, "cannot open mesh file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (s.str().empty()) input_error(path, 0, "file is empty");
-  return s.str();
+  std::string text;
+  char buffer[1 << 16];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) text.append(buffer, static_cast<size_t>(in.gcount()));
+  if (text.empty()) input_error(path, 0, "file is empty");
+  return text;
 }
 
 // Adds a polygon as a fan of triangles, checking its indices.
@@ -50,57 +52,93 @@ Eigen::Vector3d checked_point(double x, double y, double z, const std::string& p
 // that no cast from double is undefined or loses the value.
 bool is_whole_number(double v) { return std::isfinite(v) && v == std::floor(v) && std::abs(v) <= 9007199254740992.0; }
 
-// Tokens of a text file with the line each came from; '#' starts a comment.
+// Tokens of a text file read in place, with the line each comes from; '#'
+// starts a comment. The file is held once and no token is copied (a string
+// per token took about 28 times the file's size in memory).
 struct Tokens {
-  std::vector<std::string> words;
-  std::vector<long> lines;
-  size_t next = 0;
+  std::string text;
+  size_t pos = 0;   // at or before the next token
+  long at_line = 1; // the line of pos
+  std::string_view last;  // the token taken last
   const std::string* path = nullptr;
-  bool done() const { return next >= words.size(); }
-  long line() const { return next < lines.size() ? lines[next] : (lines.empty() ? 0 : lines.back()); }
-  const std::string& word() {
-    if (done()) input_error(*path, line(), "unexpected end of file");
-    return words[next++];
+
+  static bool space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
+  void skip() {
+    while (pos < text.size()) {
+      const char c = text[pos];
+      if (c == '#') {
+        while (pos < text.size() && text[pos] != '\n') ++pos;
+      } else if (space(c)) {
+        at_line += c == '\n';
+        ++pos;
+      } else {
+        return;
+      }
+    }
+  }
+  bool done() {
+    skip();
+    return pos >= text.size();
+  }
+  long line() {
+    skip();
+    return at_line;
+  }
+  void rewind() {
+    pos = 0;
+    at_line = 1;
+  }
+  std::string_view word() {
+    if (done()) input_error(*path, at_line, "unexpected end of file");
+    const size_t start = pos;
+    while (pos < text.size() && !space(text[pos]) && text[pos] != '#') ++pos;
+    last = std::string_view(text).substr(start, pos - start);
+    return last;
+  }
+  // The line of the k-th token from here (0: the next), -1 past the end;
+  // nothing is taken.
+  long line_ahead(int k) {
+    const size_t keep_pos = pos;
+    const long keep_line = at_line;
+    long found = -1;
+    for (int i = 0; i <= k && !done(); ++i) {
+      if (i == k) found = at_line;
+      word();
+    }
+    pos = keep_pos;
+    at_line = keep_line;
+    return found;
   }
   double number() {
     const long at = line();
-    const std::string& w = word();
+    const std::string_view w = word();
     char* end = nullptr;
-    const double v = std::strtod(w.c_str(), &end);
-    if (end != w.c_str() + w.size()) input_error(*path, at, "expected a number, found '" + w + "'");
+    const double v = std::strtod(w.data(), &end);  // the token ends at a space, '#' or the string's end
+    if (end != w.data() + w.size()) input_error(*path, at, "expected a number, found '" + std::string(w) + "'");
     return v;
   }
   long integer() {
     const long at = line();
     const double v = number();
-    if (!is_whole_number(v)) input_error(*path, at, "expected an integer of at most 2^53, found " + words[next - 1]);
+    if (!is_whole_number(v)) input_error(*path, at, "expected an integer of at most 2^53, found " + std::string(last));
     return static_cast<long>(v);
   }
-  // A count of items that follow: at most the words left in the file.
+  // A count of items that follow: no more than the tokens the rest of the
+  // file could hold (each takes a character and a separator).
   long count() {
     const long at = line();
     const long n = integer();
     if (n < 0) input_error(*path, at, "negative element count");
-    if (static_cast<size_t>(n) > words.size() - next)
+    if (static_cast<size_t>(n) > (text.size() - pos) / 2 + 1)
       input_error(*path, at, "a count of " + std::to_string(n) + " is more than the file holds");
     return n;
   }
 };
 
-Tokens tokenize(const std::string& text, const std::string& path) {
+Tokens tokenize(std::string text, const std::string& path) {
   Tokens t;
+  t.text = std::move(text);
   t.path = &path;
-  std::istringstream in(text);
-  std::string line;
-  long number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    const size_t hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    std::istringstream words(line);
-    std::string w;
-    while (words >> w) t.words.push_back(w), t.lines.push_back(number);
-  }
   return t;
 }
 
@@ -108,21 +146,21 @@ Tokens tokenize(const std::string& text, const std::string& path) {
 // every line that has a first word.
 template <class Visit>
 void for_each_tagged_line(const std::string& text, Visit visit) {
-  std::istringstream in(text);
-  std::string line;
   long number = 0;
-  while (std::getline(in, line)) {
+  for (size_t start = 0; start < text.size();) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
     ++number;
-    std::istringstream words(line);
+    std::istringstream words(text.substr(start, end - start));  // one line at a time, never the whole text again
+    start = end + 1;
     std::string tag;
     if (words >> tag) visit(number, tag, words);
   }
 }
 
 SurfaceMesh read_off(const std::string& path) {
-  const std::string text = read_all(path);
-  Tokens t = tokenize(text, path);
-  std::string head = t.word();
+  Tokens t = tokenize(read_all(path), path);
+  const std::string head(t.word());
   if (head != "OFF" && head != "COFF" && head != "NOFF") input_error(path, 1, "not an OFF file (header '" + head + "')");
   const long counts_line = t.line();
   const long nv = t.count(), nf = t.count();
@@ -132,9 +170,9 @@ SurfaceMesh read_off(const std::string& path) {
   // lines, the counts' line included), where nothing is skipped.
   const bool free_format =
       head == "OFF" && !t.done() &&
-      (t.line() == counts_line || (t.next + 3 < t.words.size() && t.lines[t.next + 3] == t.lines[t.next]));
+      (t.line() == counts_line || t.line_ahead(3) == t.line());
   auto skip_rest_of_line = [&](long at) {
-    while (!free_format && !t.done() && t.lines[t.next] == at) t.word();
+    while (!free_format && !t.done() && t.line() == at) t.word();
   };
   SurfaceMesh mesh;
   for (long i = 0; i < nv; ++i) {
@@ -442,19 +480,18 @@ struct GmshContent {
 };
 
 GmshContent read_gmsh_content(const std::string& path) {
-  const std::string text = read_all(path);
-  Tokens t = tokenize(text, path);
+  Tokens t = tokenize(read_all(path), path);
   auto seek = [&](const char* section) {
-    while (!t.done() && t.words[t.next] != section) ++t.next;
-    if (t.done()) input_error(path, 0, std::string("no ") + section + " section");
-    ++t.next;
+    while (!t.done() && t.word() != section) {
+    }
+    if (t.last != section) input_error(path, 0, std::string("no ") + section + " section");
   };
   seek("$MeshFormat");
   const long at = t.line();
-  const std::string version = t.word();
+  const std::string version(t.word());
   if (version.rfind("4", 0) != 0) input_error(path, at, "Gmsh format " + version + " (only 4.x is read)");
   if (t.integer() != 0) input_error(path, at, "binary Gmsh files are not read (save as ASCII)");
-  t.next = 0;
+  t.rewind();
   seek("$Nodes");
   GmshContent out;
   SurfaceMesh& mesh = out.surface;
@@ -472,7 +509,7 @@ GmshContent read_gmsh_content(const std::string& path) {
     for (long i = 0; i < count; ++i) {
       const long line = t.line();
       const double x = t.number(), y = t.number(), z = t.number();
-      if (parametric) while (!t.done() && t.lines[t.next] == line) t.word();
+      if (parametric) while (!t.done() && t.line() == line) t.word();
       index[tags[static_cast<size_t>(i)]] = static_cast<int>(mesh.vertices.size());
       mesh.vertices.push_back(checked_point(x, y, z, path, line));
     }
