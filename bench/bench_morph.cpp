@@ -19,6 +19,7 @@
 //   (default: pept:3al1, 3al1:1ubi, 1ubi:1hpv, 2k39_3models#1:#3 from data/)
 #include "cgal_reference.hpp"
 #include "forked.hpp"
+#include "morph_pairs.hpp"
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
@@ -35,6 +36,7 @@
 #include <vector>
 
 using namespace skinmesh;
+using bench::Pair;
 
 namespace {
 
@@ -63,41 +65,6 @@ struct Column {
     }
   }
 };
-
-struct Pair {
-  std::string name;
-  std::vector<Ball> source, target;
-  std::string alignment;
-};
-
-Molecule read_side(const std::string& spec) {
-  ReadOptions read;
-  std::string path = spec;
-  if (const auto hash = spec.find('#'); hash != std::string::npos) {
-    path = spec.substr(0, hash);
-    read.model = std::atoi(spec.c_str() + hash + 1);
-  }
-  return read_molecule(path, read);
-}
-
-Pair load_pair(const std::string& spec) {
-  const auto colon = spec.find(':');
-  if (colon == std::string::npos) throw std::runtime_error("a pair is SOURCE:TARGET, got " + spec);
-  std::string target_spec = spec.substr(colon + 1);
-  const std::string source_spec = spec.substr(0, colon);
-  if (!target_spec.empty() && target_spec[0] == '#')  // "file#1:#3": the same file
-    target_spec = source_spec.substr(0, source_spec.find('#')) + target_spec;
-  const Molecule source = read_side(source_spec);
-  const Molecule target = read_side(target_spec);
-  const Alignment a = align(source, target, AlignmentMethod::automatic);
-  Pair p;
-  auto base = [](const std::string& s) { return s.substr(s.find_last_of('/') + 1); };
-  p.name = base(source_spec) + " -> " + base(target_spec);
-  p.source = balls_from_molecule(source, kShrink);
-  p.target = balls_from_molecule(moved(target, a.motion), kShrink);
-  p.alignment = alignment_method_name(a.used);
-  return p;
-}
 
 std::vector<double> frame_times(int n) {
   std::vector<double> t;
@@ -250,7 +217,7 @@ int main(int argc, char** argv) {
   for (const std::string& spec : specs) {
     Pair p;
     try {
-      p = load_pair(spec);
+      p = bench::load_pair(spec, kShrink);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "bench_morph: %s\n", e.what());
       return 1;

@@ -1,0 +1,55 @@
+// A morph's two sides as the benchmarks take them: "FILE[#MODEL]:FILE[#MODEL]"
+// ("file#1:#3": two models of one file), read with the default filters,
+// the target aligned as the command's `--align auto` does (and unmoved atoms
+// put exactly on their source atoms, morph/alignment.hpp).
+#pragma once
+
+#include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/morph/alignment.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace skinmesh::bench {
+
+struct Pair {
+  std::string name;
+  std::vector<Ball> source, target;
+  std::string alignment;
+};
+
+inline Molecule read_side(const std::string& spec) {
+  ReadOptions read;
+  std::string path = spec;
+  if (const auto hash = spec.find('#'); hash != std::string::npos) {
+    path = spec.substr(0, hash);
+    read.model = std::atoi(spec.c_str() + hash + 1);
+  }
+  return read_molecule(path, read);
+}
+
+inline Pair load_pair(const std::string& spec, double shrink) {
+  const auto colon = spec.find(':');
+  if (colon == std::string::npos) throw std::runtime_error("a pair is SOURCE:TARGET, got " + spec);
+  std::string target_spec = spec.substr(colon + 1);
+  const std::string source_spec = spec.substr(0, colon);
+  if (!target_spec.empty() && target_spec[0] == '#')  // "file#1:#3": the same file
+    target_spec = source_spec.substr(0, source_spec.find('#')) + target_spec;
+  const Molecule source = read_side(source_spec);
+  Molecule target = read_side(target_spec);
+  const Alignment a = align(source, target, AlignmentMethod::automatic);
+  target = moved(std::move(target), a.motion);
+  snap_unmoved(source, target);
+  Pair p;
+  auto base = [](const std::string& s) { return s.substr(s.find_last_of('/') + 1); };
+  p.name = base(source_spec) + " -> " + base(target_spec);
+  p.source = balls_from_molecule(source, shrink);
+  p.target = balls_from_molecule(target, shrink);
+  p.alignment = alignment_method_name(a.used);
+  return p;
+}
+
+}  // namespace skinmesh::bench
