@@ -218,6 +218,24 @@ TEST_CASE("mesher options: uniform edge length, a smaller angle bound, the budge
   MeshingOptions bad;
   bad.min_angle = 35;
   CHECK_THROWS_AS(mesh_skin(complex, bad), ContractError);
+
+  // Refused before refinement: one ball of skin radius 10 A has 400 pi A^2
+  // of skin, and triangles no longer than the edge length L have at most
+  // (sqrt(3)/4) L^2 each; half that ratio is a lower bound of the count.
+  const double rho = 10, length = 0.5;
+  const SkinComplex ball = build_skin_complex({{Eigen::Vector3d::Zero(), rho * rho / 0.5}}, {0.5});
+  const double at_least = 0.5 * 4 * M_PI * rho * rho / (std::sqrt(3.0) / 4 * length * length);
+  MeshingOptions fine;
+  fine.edge_length = length;
+  const SkinMeshResult made = mesh_skin(ball, fine);
+  REQUIRE(made.status == MeshingStatus::ok);
+  CHECK(static_cast<double>(made.mesh.triangles.size()) >= at_least);  // it is a lower bound
+  fine.max_triangles = static_cast<long>(at_least) - 1;
+  const SkinMeshResult refused = mesh_skin(ball, fine);
+  CHECK(refused.status == MeshingStatus::over_budget);
+  CHECK(refused.message.find("at least") != std::string::npos);  // refused up front, not by refinement
+  fine.edge_length = 0.001;  // pept at a thousandth of an Angstrom: refused at once
+  CHECK(mesh_skin(complex, fine).status == MeshingStatus::over_budget);
 }
 
 TEST_CASE("an edge-length cap keeps the topology where the skin bends more", "[mesher]") {

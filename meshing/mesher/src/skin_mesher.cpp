@@ -692,6 +692,22 @@ void check_options(const MeshingOptions& options) {
     contract_error("the contraction threshold must be in [0, 1) times the target edge length");
 }
 
+// A lower bound of the triangles any mesh meeting `options` has, known
+// before refinement: the skin body holds every ball shrunk by sqrt(s)
+// (conv B holds every ball), so the skin's area is at least that of the
+// largest such sphere, 4 pi s w_max (a closed surface around a convex body
+// has at least its area); a triangle whose surface ball has radius at most
+// L / sqrt(3) has area at most (sqrt(3)/4) L^2, and the target edge length
+// L is nowhere above the largest size or the edge length cap. Halved, for an
+// inscribed mesh has a little less area than the skin.
+double triangles_at_least(const SkinComplex& complex, const MeshingOptions& options) {
+  double w_max = 0;
+  for (const Ball& b : complex.balls()) w_max = std::max(w_max, b.weight);
+  double longest = options.sizing.max_size;
+  if (options.edge_length > 0) longest = std::min(longest, options.edge_length);
+  return 0.5 * 4 * M_PI * complex.shrink() * w_max / (std::sqrt(3.0) / 4 * longest * longest);
+}
+
 SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSample>* samples,
                            const MeshingOptions& options) {
   check_options(options);
@@ -705,6 +721,15 @@ SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSam
     empty.status = MeshingStatus::empty_skin;
     empty.message = "the skin of this ball set is empty: no ball has a positive weight";
     return empty;
+  }
+  if (const double least = triangles_at_least(complex, options); least > static_cast<double>(options.max_triangles)) {
+    SkinMeshResult refused;
+    refused.status = MeshingStatus::over_budget;
+    refused.message = "the skin needs at least " + std::to_string(std::llround(least)) +
+                      " triangles at these sizes (its largest ball alone), more than the budget of " +
+                      std::to_string(options.max_triangles) +
+                      " triangles; raise the budget or ask for larger triangles (a larger edge length or maximum size)";
+    return refused;
   }
   detail::Refiner refiner(complex, options);
   try {
