@@ -69,25 +69,34 @@ PdbPrepass prepass_pdb(const std::string& path, const std::string& text) {
     if (end == std::string::npos) end = text.size();
     std::string line = text.substr(start, end - start);
     ++line_number;
-    // PDB is ASCII. gemmi compares record and residue names through int
-    // shifts that a byte above 0x7f makes undefined, and it reads a long
-    // line as several, so such a byte anywhere may reach a record name: in
-    // the names of an atom record it is an error, elsewhere it becomes '?'.
+    // PDB is printable ASCII. gemmi compares record and residue names
+    // through int shifts that a byte above 0x7f makes undefined, and it
+    // reads a long line as several, so such a byte anywhere may reach a
+    // record name; a NUL would cut gemmi's copy of the line short. In the
+    // names of an atom record such a byte is an error, elsewhere it
+    // becomes '?'.
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     const bool atom_record = line.compare(0, 6, "ATOM  ") == 0 || line.compare(0, 6, "HETATM") == 0;
     for (size_t i = 0; i < line.size(); ++i) {
-      if (static_cast<unsigned char>(line[i]) <= 0x7f) continue;
+      const unsigned char c = static_cast<unsigned char>(line[i]);
+      if (c <= 0x7f && (c >= 0x20 || c == '\t')) continue;
       if (atom_record && i < 27)
-        input_error(path, line_number, "a byte that is not ASCII in column " + std::to_string(i + 1) +
+        input_error(path, line_number, "a byte that is not printable ASCII in column " + std::to_string(i + 1) +
                                            " (atom and residue names are ASCII in PDB)");
       line[i] = '?';
     }
+    // Columns past a line's end are blank in PDB; gemmi reads some fields
+    // at fixed columns without checking the line's length (an SSBOND
+    // distance at columns 74-78 of a 75-column line, found by fuzzing:
+    // reads past the line's memory), so every line is padded to 80.
+    const size_t columns = line.size();
+    if (line.size() < 80) line.resize(80, ' ');
     if (line.compare(0, 5, "MODEL") == 0) {
       if (seen_model_record) ++model;
       seen_model_record = true;
     }
     if (line.compare(0, 6, "ATOM  ") == 0 || line.compare(0, 6, "HETATM") == 0) {
-      std::string body = line;
-      if (!body.empty() && body.back() == '\r') body.pop_back();
+      const std::string body = line.substr(0, columns);  // as given, without the padding
       if (body.size() < 54)
         input_error(path, line_number,
                     "coordinate record too short (" + std::to_string(body.size()) +
