@@ -85,8 +85,9 @@ bool send(int fd, const T* data, long count) {
 // In the child: run TetGen, send its exit code (0: finished) and, when it
 // finished, points, tetrahedra, one region per tetrahedron, faces, face
 // markers; then end without running the parent's atexit handlers.
-[[noreturn]] void tetgen_child(int fd, const Plc& plc, const std::string& switches) {
+[[noreturn]] void tetgen_child(int fd, const Plc& plc, const std::string& switches, pid_t parent) {
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the caller (an interrupt ends it)
+  if (::getppid() != parent) ::_exit(1);  // the caller ended before the line above took effect
   // A crash ends the child plainly: handlers the caller installed (a test
   // framework's, say) are not the child's to run.
   for (int sig : {SIGSEGV, SIGABRT, SIGBUS, SIGFPE, SIGILL}) std::signal(sig, SIG_DFL);
@@ -193,6 +194,7 @@ TetgenRun run_tetgen(const Plc& plc, const std::string& switches) {
     run.error = std::string("cannot start TetGen: ") + std::strerror(errno);
     return run;
   }
+  const pid_t parent = ::getpid();
   const pid_t child = ::fork();
   if (child < 0) {
     ::close(fds[0]);
@@ -202,7 +204,7 @@ TetgenRun run_tetgen(const Plc& plc, const std::string& switches) {
   }
   if (child == 0) {
     ::close(fds[0]);
-    tetgen_child(fds[1], plc, switches);
+    tetgen_child(fds[1], plc, switches, parent);
   }
   ::close(fds[1]);
   const std::vector<char> bytes = read_until_closed(fds[0]);
