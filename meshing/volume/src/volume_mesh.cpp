@@ -3,9 +3,9 @@
 // facet markers, region points marking the interior, the solvent and
 // cavities, hole points where nothing is to be meshed; TetGen runs with
 // `pzAYQ q<ratio>/<dihedral> [a<volume>]` and its tetrahedra, regions and
-// marked boundary faces are read from its output structure. No shell, no
-// temporary files; TetGen's errors (it throws an int in library builds)
-// become statuses with a message.
+// marked boundary faces are read from its output structure, in a child
+// process (tetgen_run.hpp says why). No shell, no temporary files; TetGen's
+// errors and crashes become statuses with a message.
 #include "skinmesh/volume/volume_mesh.hpp"
 
 #include "skinmesh/core/error.hpp"
@@ -91,18 +91,30 @@ void check_options(const VolumeOptions& options) {
   if (!(options.max_tetrahedra > 0)) contract_error("the tetrahedron budget must be positive");
 }
 
-// The volume TetGen fills (Angstrom^3): what the skin encloses, the box
-// (the surface's bounding box grown by the margin, as add_box makes it)
-// less that, or the whole box.
+// The outer box: the bounding box of the triangles' corners grown by the
+// margin on every side (Angstrom).
+struct Box {
+  Eigen::Vector3d lo, hi;
+};
+Box box_around(const std::vector<Eigen::Vector3d>& points, const std::vector<std::array<int, 3>>& triangles,
+               double margin) {
+  Box b{Eigen::Vector3d::Constant(INFINITY), Eigen::Vector3d::Constant(-INFINITY)};
+  for (const auto& t : triangles)
+    for (int v : t) {
+      b.lo = b.lo.cwiseMin(points[static_cast<size_t>(v)]);
+      b.hi = b.hi.cwiseMax(points[static_cast<size_t>(v)]);
+    }
+  b.lo -= Eigen::Vector3d::Constant(margin);
+  b.hi += Eigen::Vector3d::Constant(margin);
+  return b;
+}
+
+// The volume TetGen fills (Angstrom^3): what the skin encloses, the outer
+// box less that, or the whole box.
 double domain_volume(const SurfaceMesh& surface, double enclosed, const VolumeOptions& options) {
   if (options.domain == VolumeDomain::interior) return enclosed;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
-  for (const Eigen::Vector3d& p : surface.vertices) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const Eigen::Vector3d extent = (hi - lo).array() + 2 * options.box_margin;
-  const double box = extent.prod();
+  const Box b = box_around(surface.vertices, surface.triangles, options.box_margin);
+  const double box = (b.hi - b.lo).prod();
   return options.domain == VolumeDomain::both ? box : box - enclosed;
 }
 
@@ -161,14 +173,8 @@ std::string add_surface(const SurfaceMesh& surface_in, const VolumeOptions& opti
 // the solvent's region point.
 void add_box(double margin, Plc& plc) {
   constexpr double kBoxSpacing = 3.0;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
-  for (const auto& t : plc.facets)
-    for (int v : t) {
-      lo = lo.cwiseMin(plc.points[static_cast<size_t>(v)]);
-      hi = hi.cwiseMax(plc.points[static_cast<size_t>(v)]);
-    }
-  lo -= Eigen::Vector3d::Constant(margin);
-  hi += Eigen::Vector3d::Constant(margin);
+  const Box box = box_around(plc.points, plc.facets, margin);
+  const Eigen::Vector3d lo = box.lo, hi = box.hi;  // named, not bound: lambdas below capture them
   const Eigen::Vector3d extent = hi - lo;
   std::array<int, 3> cells{};
   for (int k = 0; k < 3; ++k) cells[static_cast<size_t>(k)] = std::max(1, static_cast<int>(std::ceil(extent[k] / kBoxSpacing)));
