@@ -3,6 +3,7 @@
 // file is written.
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "meshing_feedback.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
@@ -28,6 +29,7 @@ struct MeshCommandOptions {
   MoleculeOptions molecule;
   std::string output, report, svg;
   MeshingOptions meshing;
+  double max_memory_gb = 0;  // 0: the memory available when the command starts
   bool single_precision = false;
   bool no_self_intersections = false;
 };
@@ -74,6 +76,10 @@ void add_mesh_options(CLI::App& cmd, MeshCommandOptions& o) {
       ->capture_default_str();
   cmd.add_option("--max-triangles", o.meshing.max_triangles, "stop with an error past this many triangles")
       ->check(finite_number())->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd.add_option("--max-memory", o.max_memory_gb,
+                 "refuse at once a job whose estimated memory passes this many GB (0: the memory available now)")
+      ->check(finite_number())->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd.add_option("--threads", o.meshing.threads, "threads for the parallel passes (0: all)")->check(finite_number())->check(CLI::NonNegativeNumber);
   cmd.add_flag("--float", o.single_precision, "write single-precision coordinates (smaller files)");
@@ -162,19 +168,14 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   const double seconds_complex = seconds_since(start);
 
   MeshingOptions meshing = o.meshing;
-  if (progress)
-    meshing.progress = [](const MeshingProgress& p) {
-      std::fprintf(stderr, "\rskinmesh: %-9s %9ld vertices, %8ld pending", p.stage, p.vertices, p.pending);
-      std::fflush(stderr);
-    };
+  meshing.max_memory_bytes = o.max_memory_gb > 0 ? o.max_memory_gb * 1e9 : available_memory_bytes();
+  if (progress) meshing.progress = meshing_progress_line();
   const SkinMeshResult result = mesh_skin(complex, meshing);
-  if (progress) std::cerr << "\r" << std::string(60, ' ') << "\r";
+  if (progress) std::cerr << "\r" << std::string(70, ' ') << "\r";
   if (result.status == MeshingStatus::empty_skin) input_error(o.molecule.path, 0, result.message);
   if (result.status != MeshingStatus::ok) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": " << result.message << "\n";
-    if (result.status == MeshingStatus::over_budget)
-      std::cerr << "skinmesh: raise --max-triangles or ask for larger triangles (--epsilon, --edge-length, "
-                   "--tolerance)\n";
+    if (result.status == MeshingStatus::over_budget) std::cerr << "skinmesh: " << over_budget_hint(result) << "\n";
     return ExitCode::not_met;
   }
   if (progress) std::cerr << "skinmesh: meshed; grading\n";
@@ -198,6 +199,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
                  {"on_surface_error", to_json(g.surface_error)},
                  {"guarantees", guarantees_json(g)},
                  {"refinement", refinement_json(s)},
+                 {"estimated_triangles", std::llround(result.estimated_triangles)},
                  {"seconds",
                   {{"complex", seconds_complex},
                    {"seeding", s.seconds_seeding},

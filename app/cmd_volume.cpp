@@ -3,6 +3,7 @@
 // mesh; written as TetGen's files, VTK (.vtu) and Gmsh (.msh), with a report.
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "meshing_feedback.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
@@ -29,6 +30,7 @@ struct VolumeCommandOptions {
   MoleculeOptions molecule;
   std::string output, report;
   MeshingOptions meshing;
+  double max_memory_gb = 0;  // 0: the memory available when the command starts
   VolumeOptions volume;
   std::string domain = "interior";
   bool drop_cavities = false;
@@ -62,6 +64,11 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
       ->check(finite_number())->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd.add_option("--edge-length", o.meshing.edge_length, "surface: largest edge length, A")->check(finite_number())->check(CLI::PositiveNumber);
+  cmd.add_option("--max-memory", o.max_memory_gb,
+                 "surface: refuse at once a skin mesh whose estimated memory passes this many GB (0: the memory "
+                 "available now)")
+      ->check(finite_number())->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 }
 
 VolumeOptions volume_options(const VolumeCommandOptions& o) {
@@ -133,11 +140,15 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   if (m.atoms.empty()) input_error(o.molecule.path, 0, "no atoms left to mesh");
   const auto balls = balls_from_molecule(m, o.molecule.shrink, o.molecule.convention());
   const SkinComplex complex = build_skin_complex(balls, {o.molecule.shrink});
-  if (progress) std::cerr << "skinmesh: meshing the skin\n";
-  const SkinMeshResult surface = mesh_skin(complex, o.meshing);
+  MeshingOptions meshing = o.meshing;
+  meshing.max_memory_bytes = o.max_memory_gb > 0 ? o.max_memory_gb * 1e9 : available_memory_bytes();
+  if (progress) meshing.progress = meshing_progress_line();
+  const SkinMeshResult surface = mesh_skin(complex, meshing);
+  if (progress) std::cerr << "\r" << std::string(70, ' ') << "\r";
   if (surface.status == MeshingStatus::empty_skin) input_error(o.molecule.path, 0, surface.message);
   if (surface.status != MeshingStatus::ok) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": " << surface.message << "\n";
+    if (surface.status == MeshingStatus::over_budget) std::cerr << "skinmesh: " << over_budget_hint(surface, true) << "\n";
     return ExitCode::not_met;
   }
   GuaranteeOptions bounds;

@@ -329,6 +329,31 @@ TEST_CASE("interpolate --all-pairs refuses a set that would not fit, at once", "
   CHECK_FALSE(std::ifstream(out.path()).good());
 }
 
+TEST_CASE("extreme but legal inputs are refused at once, naming the sizes that would fit", "[cli][bad][estimate]") {
+  // Each ran minutes to the triangle budget before the estimate (issue 14).
+  skinmesh::test::TempFile ball("big_ball.xyzr", "0 0 0 1000\n");
+  skinmesh::test::TempFile out("refused.ply");
+  std::remove(out.path().c_str());
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  // Exit 3, the file named, `says` in the message, no output of the command.
+  auto refused = [&](const std::string& args, const std::string& input, const std::string& says) {
+    const Run r = run(args + " -o " + out.path());
+    INFO(r.output);
+    CHECK(r.code == 3);
+    CHECK(r.output.find(input) != std::string::npos);
+    CHECK(r.output.find(says) != std::string::npos);
+    CHECK_FALSE(std::ifstream(out.path()).good());
+    CHECK_FALSE(std::ifstream(out.path() + ".vtu").good());
+    return r.output;
+  };
+  refused("mesh " + ball.path(), "big_ball.xyzr", "this would fit: --max-size ");
+  refused("mesh " + pept + " --tolerance 1e-300", "pept.pdb", "this would fit: --tolerance ");
+  refused("mesh " + pept + " --max-memory 0.001", "pept.pdb", "more than the memory allows");
+  // volume sets the surface sizes by --epsilon and --edge-length only, and names only those.
+  const std::string volume = refused("volume " + pept + " --edge-length 0.01", "pept.pdb", "this would fit: --edge-length ");
+  CHECK(volume.find("--tolerance") == std::string::npos);
+}
+
 TEST_CASE("an empty skin is said to be empty; non-UTF-8 names do not break --json", "[cli][bad]") {
   // Every weight negative: no surface. The error says so and names the file.
   skinmesh::test::TempFile negative("negative.wpts", "0 0 0 -1\n3 0 0 -2\n");

@@ -154,6 +154,8 @@ class Refiner {
     max_radius_edge_ = 1.0 / (2.0 * std::sin(options.min_angle * M_PI / 180.0));
   }
 
+  // For progress reports: the vertex count the estimate expects (0: unknown).
+  void expect_vertices(double vertices) { expected_vertices_ = vertices; }
   // Seeds the skin, or starts from `samples` (remesh_skin) when given.
   SkinMeshResult run(const std::vector<SkinSample>* samples = nullptr);
   // mesh_patch: the samples with their roles, refined where patch facets fail.
@@ -239,6 +241,7 @@ class Refiner {
   std::vector<PatchRole> roles_;  // by sample id (mesh_patch); empty for the whole skin
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();
+  double expected_vertices_ = 0;
 };
 
 }  // namespace skinmesh::detail

@@ -3,6 +3,7 @@
 // the mesh. The clean-up by edge contraction is in edge_contraction.cpp.
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/core/error.hpp"
+#include "skinmesh/mesher/triangle_estimate.hpp"
 
 #include "refiner.hpp"
 #include "skin_seeds.hpp"
@@ -11,7 +12,9 @@
 #include <CGAL/hilbert_sort.h>
 #include <CGAL/property_map.h>
 
+#include <iomanip>
 #include <numeric>
+#include <sstream>
 
 namespace skinmesh::detail {
 
@@ -122,6 +125,7 @@ void Refiner::report(const char* stage, Report when, long pending) {
   p.stage = stage;
   p.vertices = static_cast<long>(dt_.number_of_vertices());
   p.pending = pending;
+  p.expected_vertices = expected_vertices_;
   options_.progress(p);
 }
 
@@ -688,6 +692,8 @@ void check_options(const MeshingOptions& options) {
       !(options.sizing.max_size >= options.sizing.min_size))
     contract_error("sizing: epsilon and min_size must be positive, max_size >= min_size");
   if (options.max_triangles <= 0) contract_error("the triangle budget must be positive");
+  if (!(options.max_memory_bytes >= 0) || !std::isfinite(options.max_memory_bytes))
+    contract_error("the memory limit must be a finite number of bytes, or 0 for none");
   if (!(options.contract_below >= 0 && options.contract_below < 1))
     contract_error("the contraction threshold must be in [0, 1) times the target edge length");
 }
@@ -706,6 +712,54 @@ double triangles_at_least(const SkinComplex& complex, const MeshingOptions& opti
   double longest = options.sizing.max_size;
   if (options.edge_length > 0) longest = std::min(longest, options.edge_length);
   return 0.5 * 4 * M_PI * complex.shrink() * w_max / (std::sqrt(3.0) / 4 * longest * longest);
+}
+
+// A count for a message: whole below 1e15, else in powers of ten (never cast
+// past the range of an integer).
+std::string rounded_count(double n) {
+  if (n < 1e15) return std::to_string(std::llround(n));
+  std::ostringstream text;
+  text << std::setprecision(3) << n;
+  return text.str();
+}
+
+// mesh_skin's refusal before refinement: even the low end of the estimate
+// passes what the options afford (triangle budget or memory).
+std::optional<SkinMeshResult> refuse_if_unaffordable(const SkinAreaProfile& profile, const TriangleEstimate& estimate,
+                                                     const MeshingOptions& options) {
+  const double affordable = affordable_triangles(options);
+  if (estimate.low() <= affordable) return std::nullopt;
+  const double expected = estimate.triangles;
+  SkinMeshResult refused;
+  refused.status = MeshingStatus::over_budget;
+  refused.estimated_triangles = expected;
+  refused.fitting_sizes = sizes_that_fit(profile, options, affordable);
+  std::ostringstream text;
+  text << "the skin needs about " << rounded_count(expected) << " triangles at these sizes (estimated from its area, "
+       << rounded_count(profile.area) << " A^2, before refinement; within "
+       << std::lround((kTriangleEstimateSpread - 1) * 100) << "% either way), more than ";
+  if (affordable < static_cast<double>(options.max_triangles))
+    text << "the memory allows (about " << std::setprecision(3) << estimate.peak_bytes / 1e9
+         << " GB needed, " << options.max_memory_bytes / 1e9 << " GB available)";
+  else
+    text << "the budget of " << options.max_triangles << " triangles";
+  if (refused.fitting_sizes.empty())
+    text << "; no single size option fits it: the skin has too many small patches for this budget";
+  else {
+    text << "; sizes that would fit:";
+    const char* between_fits = " ";
+    for (const FittingSize& fit : refused.fitting_sizes) {
+      text << between_fits;
+      const char* between_changes = "";
+      for (const SizeChange& change : fit.changes) {
+        text << between_changes << size_option_name(change.option) << " " << std::setprecision(2) << change.value;
+        between_changes = " with ";
+      }
+      between_fits = ", or ";
+    }
+  }
+  refused.message = text.str();
+  return refused;
 }
 
 SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSample>* samples,
@@ -731,9 +785,21 @@ SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSam
                       " triangles; raise the budget or ask for larger triangles (a larger edge length or maximum size)";
     return refused;
   }
+  // The estimate from the skin's area (mesh_skin only: a morph frame's remesh
+  // starts from a mesh that fitted, and the profile would cost it time).
+  double expected_triangles = 0;
+  if (!samples) {
+    const SkinAreaProfile profile = skin_area_profile(complex);
+    const TriangleEstimate estimate = estimate_triangles(profile, options);
+    expected_triangles = estimate.triangles;
+    if (auto refused = refuse_if_unaffordable(profile, estimate, options)) return *refused;
+  }
   detail::Refiner refiner(complex, options);
+  refiner.expect_vertices(expected_triangles / 2);  // a closed surface mesh: about two triangles per vertex
   try {
-    return refiner.run(samples);
+    SkinMeshResult result = refiner.run(samples);
+    result.estimated_triangles = expected_triangles;
+    return result;
   } catch (const detail::RefinementStopped& stop) {
     SkinMeshResult result;
     result.status = stop.status;

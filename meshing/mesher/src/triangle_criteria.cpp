@@ -3,20 +3,16 @@
 // refinement of the skin and Boissonnat and Oudot's surface Delaunay balls.
 #include "skinmesh/mesher/skin_mesher.hpp"
 
+#include "criteria_constants.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
 
 namespace skinmesh {
-namespace {
 
-// The distance criterion measures the skin's deviation at one point of each
-// triangle (its circumcentre's normal line); the deviation elsewhere in the
-// triangle is a little larger, so the criterion keeps this margin.
-constexpr double kToleranceMargin = 0.7;
-
-}  // namespace
+using detail::kToleranceMargin;
 
 const char* triangle_defect_name(TriangleDefect defect) {
   switch (defect) {

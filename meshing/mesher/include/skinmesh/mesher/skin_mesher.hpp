@@ -34,6 +34,10 @@ struct MeshingProgress {
   const char* stage = "";      // "seeding", "refining", "checking"
   long vertices = 0;
   long pending = 0;            // bad triangles waiting in the queue
+  // Vertices the finished mesh is expected to have, from the estimate made
+  // before refinement (triangle_estimate.hpp; within about 25% either way);
+  // 0 when not known.
+  double expected_vertices = 0;
 };
 
 struct MeshingOptions {
@@ -53,7 +57,13 @@ struct MeshingOptions {
   // (bench_mesher): 0.5 contracts 1,817 edges, 2% fewer triangles, for 51%
   // more time.
   double contract_below = 0.0;
-  long max_triangles = 4'000'000;  // refinement stops (status over_budget) past this many triangles
+  // Refinement stops (status over_budget) past this many triangles, and a
+  // job whose estimate (triangle_estimate.hpp) passes it even at the low end
+  // of the estimate's spread is refused before refinement.
+  long max_triangles = 4'000'000;
+  // Bytes: a job whose estimated peak memory passes this, even at the low end
+  // of the estimate's spread, is refused before refinement; 0: no limit.
+  double max_memory_bytes = 0;
   int threads = 0;             // 0: all hardware threads
   std::function<void(const MeshingProgress&)> progress;  // called now and then, from the calling thread
 };
@@ -120,9 +130,27 @@ enum class MeshingStatus {
 };
 const char* meshing_status_name(MeshingStatus status);
 
+// Size options changed, together, to values at which the estimate, even at
+// the high end of its spread, fits the budget: what a refused job could ask
+// for.
+enum class SizeOption { tolerance, epsilon, edge_length, max_size, min_size };
+const char* size_option_name(SizeOption option);
+struct SizeChange {
+  SizeOption option;
+  double value;                    // Angstrom, or dimensionless for epsilon
+};
+struct FittingSize {
+  std::vector<SizeChange> changes; // one option alone, or all sizes scaled together
+};
+
 struct SkinMeshResult {
   MeshingStatus status = MeshingStatus::ok;
   std::string message;             // what happened, when status != ok (names no command-line flag)
+  double estimated_triangles = 0;  // the estimate made before refinement (mesh_skin; 0 for remesh_skin)
+  // over_budget before refinement: size changes that would fit, each option
+  // alone where one can, else all sizes scaled together (empty when nothing
+  // fits: the skin has more small patches than the budget).
+  std::vector<FittingSize> fitting_sizes;
   SurfaceMesh mesh;                // triangles oriented outward; normals and mixed cells per vertex; empty unless ok
   MeshingStats stats;
   // remesh_skin only: per vertex of `mesh`, the index of the given sample it

@@ -1,0 +1,25 @@
+// What the terminal shows while the mesher works and when it refuses a job:
+// shared by `mesh` and `volume`.
+#pragma once
+
+#include "skinmesh/mesher/skin_mesher.hpp"
+
+#include <string>
+
+namespace skinmesh::app {
+
+// A progress line rewritten in place: stage, vertices, and (when the mesher
+// has an estimate) the share done and the time left at the pace so far.
+std::function<void(const MeshingProgress&)> meshing_progress_line();
+
+// For a job over its budget: the command-line options that would fit it
+// (from SkinMeshResult::fitting_sizes), or the general advice. A command with
+// only --epsilon and --edge-length (volume) passes surface_sizes_only.
+std::string over_budget_hint(const SkinMeshResult& result, bool surface_sizes_only = false);
+
+// Bytes of memory this process may still use: the smaller of the system's
+// available memory (/proc/meminfo MemAvailable) and what its cgroup's limit
+// leaves (memory.max - memory.current); 0 when neither can be read.
+double available_memory_bytes();
+
+}  // namespace skinmesh::app
