@@ -744,7 +744,7 @@ std::optional<SkinMeshResult> refuse_if_unaffordable(const SkinAreaProfile& prof
   else
     text << "the budget of " << options.max_triangles << " triangles";
   if (refused.fitting_sizes.empty())
-    text << "; no single size option fits it: the skin has too many small patches for this budget";
+    text << "; no coarser sizes fit it: the skin has more small patches than this budget allows";
   else {
     text << "; sizes that would fit:";
     const char* between_fits = " ";
@@ -804,6 +804,11 @@ SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSam
     SkinMeshResult result;
     result.status = stop.status;
     result.message = stop.message;
+    result.estimated_triangles = expected_triangles;
+    if (stop.status == MeshingStatus::over_budget && expected_triangles > 0) {
+      const size_t cut = std::min(result.message.find(';'), result.message.size());
+      result.message.insert(cut, " (estimated before refinement: about " + rounded_count(expected_triangles) + ")");
+    }
     return result;
   }
 }
