@@ -168,7 +168,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   const double seconds_complex = seconds_since(start);
 
   MeshingOptions meshing = o.meshing;
-  meshing.max_memory_bytes = o.max_memory_gb > 0 ? o.max_memory_gb * 1e9 : available_memory_bytes();
+  meshing.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
   if (progress) meshing.progress = meshing_progress_line();
   const SkinMeshResult result = mesh_skin(complex, meshing);
   if (progress) std::cerr << "\r" << std::string(70, ' ') << "\r";

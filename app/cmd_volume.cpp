@@ -141,7 +141,7 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   const auto balls = balls_from_molecule(m, o.molecule.shrink, o.molecule.convention());
   const SkinComplex complex = build_skin_complex(balls, {o.molecule.shrink});
   MeshingOptions meshing = o.meshing;
-  meshing.max_memory_bytes = o.max_memory_gb > 0 ? o.max_memory_gb * 1e9 : available_memory_bytes();
+  meshing.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
   if (progress) meshing.progress = meshing_progress_line();
   const SkinMeshResult surface = mesh_skin(complex, meshing);
   if (progress) std::cerr << "\r" << std::string(70, ' ') << "\r";

@@ -22,4 +22,10 @@ std::string over_budget_hint(const SkinMeshResult& result, bool surface_sizes_on
 // leaves (memory.max - memory.current); 0 when neither can be read.
 double available_memory_bytes();
 
+// The memory limit for --max-memory GB: that many bytes, or when it is 0 the
+// memory available now.
+inline double memory_limit_bytes(double max_memory_gb) {
+  return max_memory_gb > 0 ? max_memory_gb * 1e9 : available_memory_bytes();
+}
+
 }  // namespace skinmesh::app
