@@ -205,6 +205,7 @@ class Refiner {
   std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
   bool global_pass(std::vector<FacetEval>* restricted);
   bool repair_stars(const std::vector<FacetEval>& restricted, const std::vector<Vertex_handle>& vertices);
+  std::optional<Projection> isolated_repair_point(Vertex_handle v) const;
   void local_passes();
   SurfaceMesh extract(const std::vector<FacetEval>& restricted, std::vector<long>* origins) const;
   void report(const char* stage, Report when, long pending = 0);

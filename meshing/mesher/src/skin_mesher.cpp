@@ -443,6 +443,57 @@ std::vector<Vertex_handle> Refiner::star_checked_only(std::vector<Vertex_handle>
 // (its link is a single cycle, which also makes every edge shared by exactly
 // two triangles) and queues or makes the repairs. `restricted` must hold every
 // restricted facet around each of them. Returns true when all are disks.
+// A skin point to split the restricted Voronoi cell of a sample that has no
+// restricted triangle: the projection of one of its Voronoi vertices, the
+// farthest from the sample. When a projection lands in another sample's cell
+// (the skin in this cell is a thin sliver, as along the creases of a skin
+// whose shrink factor is near 1), the skin point found by halving the way
+// from the sample towards it until it falls in this cell is used instead: a
+// point outside does not split this cell, and repeating it went on for 171
+// passes (pept at s = 0.995) or for ever (a 0.005 A void of 1ubi, whose
+// Voronoi vertices project onto the outer skin). Only when no such point
+// exists is an outside projection used.
+std::optional<Projection> Refiner::isolated_repair_point(Vertex_handle v) const {
+  std::vector<Cell_handle> cells;
+  dt_.incident_cells(v, std::back_inserter(cells));
+  const Eigen::Vector3d pv = to_eigen(v->point());
+  const auto owner = [&](const Projection& p, Cell_handle hint) {
+    return dt_.nearest_vertex(K::Point_3(p.point[0], p.point[1], p.point[2]), hint);
+  };
+  std::optional<Projection> best;
+  bool best_in_cell = false;
+  const auto consider = [&](const Projection& p, bool in_cell) {
+    if (!best || (in_cell && !best_in_cell) ||
+        (in_cell == best_in_cell && (p.point - pv).norm() > (best->point - pv).norm())) {
+      best = p;
+      best_in_cell = in_cell;
+    }
+  };
+  for (const Cell_handle& c : cells) {
+    if (dt_.is_infinite(c)) continue;
+    const Eigen::Vector3d dual = to_eigen(dt_.dual(c));
+    const Projection p = complex_.project(dual, v->info().cell);
+    if (!p.converged || (p.point - pv).norm() < 1e-6) continue;
+    const Vertex_handle nearest = owner(p, c);
+    if ((to_eigen(nearest->point()) - p.point).norm() < 1e-6) continue;
+    if (!active(nearest->info().id)) continue;  // a patch does not grow into its context
+    if (nearest == v) {
+      consider(p, true);
+      continue;
+    }
+    consider(p, false);
+    for (double f = 0.5; f > 1e-6; f *= 0.5) {
+      const Projection q = complex_.project(pv + f * (dual - pv), v->info().cell);
+      if (!q.converged || (q.point - pv).norm() < 1e-6) break;
+      if (owner(q, c) == v) {
+        consider(q, true);
+        break;
+      }
+    }
+  }
+  return best;
+}
+
 bool Refiner::repair_stars(const std::vector<FacetEval>& restricted, const std::vector<Vertex_handle>& vertices) {
   bool clean = true;
   Links link;
@@ -474,32 +525,10 @@ bool Refiner::repair_stars(const std::vector<FacetEval>& restricted, const std::
     }
   }
   // A sample with no restricted triangle: the skin around it escapes every
-  // Voronoi edge of its cell. Add a skin point inside that Voronoi cell (the
-  // projection of one of its Voronoi vertices, the farthest from the sample);
-  // the triangulation then sees that piece. A projection that lands in another
-  // sample's cell is used only when none stays in this one: it does not
-  // split this cell, so repeating it can go on for ever (a 0.005 A void of
-  // 1ubi does that when its Voronoi vertices project onto the outer skin).
+  // Voronoi edge of its cell. Add a skin point inside that Voronoi cell; the
+  // triangulation then sees that piece (isolated_repair_point).
   for (const Vertex_handle& v : isolated) {
-    std::vector<Cell_handle> cells;
-    dt_.incident_cells(v, std::back_inserter(cells));
-    const Eigen::Vector3d pv = to_eigen(v->point());
-    std::optional<Projection> best;
-    bool best_in_cell = false;
-    for (const Cell_handle& c : cells) {
-      if (dt_.is_infinite(c)) continue;
-      const Projection p = complex_.project(to_eigen(dt_.dual(c)), v->info().cell);
-      if (!p.converged || (p.point - pv).norm() < 1e-6) continue;
-      const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(p.point[0], p.point[1], p.point[2]), c);
-      if ((to_eigen(nearest->point()) - p.point).norm() < 1e-6) continue;
-      if (!active(nearest->info().id)) continue;  // a patch does not grow into its context
-      const bool in_cell = nearest == v;
-      if (!best || (in_cell && !best_in_cell) ||
-          (in_cell == best_in_cell && (p.point - pv).norm() > (best->point - pv).norm())) {
-        best = p;
-        best_in_cell = in_cell;
-      }
-    }
+    const std::optional<Projection> best = isolated_repair_point(v);
     if (!best)
       throw RefinementStopped{MeshingStatus::unrepairable,
                               "a sample of the skin has no triangle and no repair point was found"};
