@@ -47,6 +47,10 @@ const char* flag_of(SizeOption option, bool surface_sizes_only) {
 
 std::string over_budget_hint(const SkinMeshResult& result, bool surface_sizes_only) {
   std::ostringstream text;
+  if (result.fitting_shrink > 0) {
+    text << "this would fit: --shrink " << result.fitting_shrink << " (or raise --max-triangles or --max-memory)";
+    return text.str();
+  }
   const char* between_fits = "";
   for (const FittingSize& fit : result.fitting_sizes) {
     std::ostringstream flags;

@@ -349,6 +349,8 @@ TEST_CASE("extreme but legal inputs are refused at once, naming the sizes that w
   refused("mesh " + ball.path(), "big_ball.xyzr", "this would fit: --max-size ");
   refused("mesh " + pept + " --tolerance 1e-300", "pept.pdb", "this would fit: --tolerance ");
   refused("mesh " + pept + " --max-memory 0.001", "pept.pdb", "more than the memory allows");
+  // Necks sharper than any size: only a smaller shrink factor helps.
+  refused("mesh " + pept + " --shrink 0.999999", "pept.pdb", "this would fit: --shrink 0.99");
   // volume sets the surface sizes by --epsilon and --edge-length only, and names only those.
   const std::string volume = refused("volume " + pept + " --edge-length 0.01", "pept.pdb", "this would fit: --edge-length ");
   CHECK(volume.find("--tolerance") == std::string::npos);

@@ -8,6 +8,7 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/mesher/triangle_estimate.hpp"
+#include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include <catch2/catch.hpp>
@@ -159,5 +160,51 @@ TEST_CASE("extreme legal inputs are refused at once with the estimate", "[estima
     REQUIRE(refused.status == MeshingStatus::over_budget);
     CHECK(refused.message.find("memory") != std::string::npos);
     CHECK(affordable_triangles(options) < 1000);
+  }
+}
+
+TEST_CASE("a shrink factor near 1: creases are estimated, the mesher settles, refusals name a shrink factor that fits",
+          "[estimate][mesher]") {
+  // At s = 0.999 the skin's necks bend with radii of curvature of about
+  // 0.001 A. Before the crease term the estimate was 9,651 triangles against
+  // 77,244 meshed, and the mesher chased one sample without triangles for 200
+  // passes and failed (isolated_repair_point).
+  SECTION("s = 0.999 meshes with every guarantee, near its estimate") {
+    const double s = 0.999;
+    const auto balls = balls_from_molecule(read_molecule(data_file("pept.pdb")), s);
+    const SkinComplex complex = build_skin_complex(balls, {s});
+    const TriangleEstimate estimate = estimate_triangles(skin_area_profile(complex), {});
+    const SkinMeshResult result = mesh_skin(complex);
+    INFO(result.message);
+    REQUIRE(result.status == MeshingStatus::ok);
+    CHECK(result.stats.passes <= 20);
+    const double count = static_cast<double>(result.mesh.triangles.size());
+    INFO(count << " triangles, estimate " << estimate.triangles << " of which creases " << estimate.creases);
+    CHECK(estimate.creases > estimate.size_bound + estimate.distance_bound);  // most of it is creases
+    CHECK(count >= estimate.low());
+    CHECK(count <= 1.4 * estimate.triangles);
+    CHECK(check_guarantees(result.mesh, balls, s, {}).all_hold());
+  }
+  SECTION("s = 0.999999 is refused at once, and a budget's shrink factor then fits") {
+    const SkinMeshResult refused = mesh_skin(complex_of("pept.pdb", 0.999999));
+    INFO(refused.message);
+    REQUIRE(refused.status == MeshingStatus::over_budget);
+    CHECK(refused.stats.seeds == 0);
+    CHECK(refused.fitting_sizes.empty());  // no size changes the creases
+    CHECK(refused.fitting_shrink > 0.99);
+    CHECK(refused.fitting_shrink < 0.999999);
+    CHECK(refused.message.find("shrink factor") != std::string::npos);
+    // At s = 0.9999 pept meshes to 484,360 triangles: a budget of 60,000 is
+    // refused, and the shrink factor named meshes within it.
+    const long budget = 60000;
+    const SkinMeshResult over = mesh_skin(complex_of("pept.pdb", 0.9999), with(budget));
+    INFO(over.message);
+    REQUIRE(over.status == MeshingStatus::over_budget);
+    REQUIRE(over.fitting_shrink > 0.99);
+    REQUIRE(over.fitting_shrink < 0.9999);
+    const SkinMeshResult fitted = mesh_skin(complex_of("pept.pdb", over.fitting_shrink), with(budget));
+    INFO("shrink " << over.fitting_shrink << ": " << fitted.message);
+    CHECK(fitted.status == MeshingStatus::ok);
+    CHECK(static_cast<long>(fitted.mesh.triangles.size()) <= budget);
   }
 }

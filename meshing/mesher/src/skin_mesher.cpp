@@ -755,24 +755,30 @@ std::string rounded_count(double n) {
 // mesh_skin's refusal before refinement: even the low end of the estimate
 // passes what the options afford (triangle budget or memory).
 std::optional<SkinMeshResult> refuse_if_unaffordable(const SkinAreaProfile& profile, const TriangleEstimate& estimate,
-                                                     const MeshingOptions& options) {
+                                                     double shrink, const MeshingOptions& options) {
   const double affordable = affordable_triangles(options);
   if (estimate.low() <= affordable) return std::nullopt;
   const double expected = estimate.triangles;
+  const double spread = estimate.creases > expected / 2 ? kCreaseEstimateSpread : kTriangleEstimateSpread;
   SkinMeshResult refused;
   refused.status = MeshingStatus::over_budget;
   refused.estimated_triangles = expected;
   refused.fitting_sizes = sizes_that_fit(profile, options, affordable);
+  if (refused.fitting_sizes.empty()) refused.fitting_shrink = shrink_that_fits(estimate, shrink, affordable);
   std::ostringstream text;
   text << "the skin needs about " << rounded_count(expected) << " triangles at these sizes (estimated from its area, "
        << rounded_count(profile.area) << " A^2, before refinement; within "
-       << std::lround((kTriangleEstimateSpread - 1) * 100) << "% either way), more than ";
+       << std::lround((spread - 1) * 100) << "% either way), more than ";
   if (affordable < static_cast<double>(options.max_triangles))
     text << "the memory allows (about " << std::setprecision(3) << estimate.peak_bytes / 1e9
          << " GB needed, " << options.max_memory_bytes / 1e9 << " GB available)";
   else
     text << "the budget of " << options.max_triangles << " triangles";
-  if (refused.fitting_sizes.empty())
+  if (refused.fitting_shrink > 0)
+    text << "; most of them (about " << rounded_count(estimate.creases)
+         << ") along necks sharper than any size asks for, as the shrink factor is close to 1 (" << shrink
+         << "), which no coarser size changes; a shrink factor of at most " << refused.fitting_shrink << " would fit";
+  else if (refused.fitting_sizes.empty())
     text << "; no coarser sizes fit it: the skin has more small patches than this budget allows";
   else {
     text << "; sizes that would fit:";
@@ -821,7 +827,7 @@ SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSam
     const SkinAreaProfile profile = skin_area_profile(complex);
     const TriangleEstimate estimate = estimate_triangles(profile, options);
     expected_triangles = estimate.triangles;
-    if (auto refused = refuse_if_unaffordable(profile, estimate, options)) return *refused;
+    if (auto refused = refuse_if_unaffordable(profile, estimate, complex.shrink(), options)) return *refused;
   }
   detail::Refiner refiner(complex, options);
   refiner.expect_vertices(expected_triangles / 2);  // a closed surface mesh: about two triangles per vertex

@@ -146,6 +146,18 @@ constexpr double kTrianglesPerSizeArea = 1.3;
 constexpr double kTrianglesPerDistanceArea = 1.0;
 constexpr double kTrianglesPerCell = 1.7;
 constexpr double kBytesPerTriangle = 1750;
+// Creases: where a hyperboloid patch bends more sharply than the sizes go
+// (radius of curvature under kCreaseRadius, far below the default size floor
+// of 0.05 A), the refinement for topology (one crossing per normal line,
+// every vertex star a disk) resolves the neck, not the size bound. On a neck
+// of waist radius a the smallest radius of curvature is rho = (1-s) a / s
+// (docs/math.md section 3), so its area over rho^2 counts its length over
+// rho, which grows as s / (1-s), whatever the size options. The constant is
+// fitted on pept, 3al1 and 1ubi at s = 0.99-0.9999 (measured over estimated
+// 0.85-1.33, docs/benchmarks.md); kCreaseRadius is where the measured counts
+// begin to pass the area terms (s = 0.99, whose necks bend at about 0.01 A).
+constexpr double kCreaseRadius = 0.01;  // Angstrom
+constexpr double kTrianglesPerCreaseArea = 0.086;
 
 struct BallBound {
   double radius = 0;
@@ -192,12 +204,13 @@ TriangleEstimate estimate_triangles(const SkinAreaProfile& profile, const Meshin
       const double radius2 = area_spanned(bound.radius, rho) / M_PI;  // r^2 on a flat patch
       if (bound.by_distance) estimate.distance_bound += kTrianglesPerDistanceArea * bin.area / radius2;
       else estimate.size_bound += kTrianglesPerSizeArea * bin.area / radius2;
+      if (!sphere_patch && rho < kCreaseRadius) estimate.creases += kTrianglesPerCreaseArea * bin.area / (rho * rho);
     }
   };
   add(profile.sphere, true);
   add(profile.hyperboloid, false);
   estimate.per_cell = kTrianglesPerCell * static_cast<double>(profile.cells_with_skin);
-  estimate.triangles = estimate.size_bound + estimate.distance_bound + estimate.per_cell;
+  estimate.triangles = estimate.size_bound + estimate.distance_bound + estimate.per_cell + estimate.creases;
   estimate.peak_bytes = kBytesPerTriangle * estimate.triangles;
   return estimate;
 }
@@ -299,6 +312,20 @@ std::vector<FittingSize> sizes_that_fit(const SkinAreaProfile& profile, const Me
       together.changes.push_back({option, round_up_two_digits(value)});
   fits.push_back(together);
   return fits;
+}
+
+double shrink_that_fits(const TriangleEstimate& estimate, double shrink, double triangles) {
+  if (!(estimate.creases > 0) || !(shrink > 0 && shrink < 1)) return 0;
+  const double others = estimate.size_bound + estimate.distance_bound + estimate.per_cell;
+  const double room = triangles / kCreaseEstimateSpread - others;
+  if (!(room > 0)) return 0;
+  // The crease term grows as s / (1-s) (kTrianglesPerCreaseArea); the other
+  // terms barely change with s near 1.
+  const double ratio = shrink / (1 - shrink) * room / estimate.creases;
+  const double fitting = ratio / (1 + ratio);
+  if (!(fitting < shrink)) return 0;
+  const double rounded = 1 - round_up_two_digits(1 - fitting);  // typeable, and smaller still
+  return rounded > 0 ? rounded : 0;
 }
 
 }  // namespace skinmesh

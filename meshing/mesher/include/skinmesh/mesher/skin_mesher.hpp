@@ -151,6 +151,10 @@ struct SkinMeshResult {
   // alone where one can, else all sizes scaled together (empty when nothing
   // fits: the skin has more small patches than the budget).
   std::vector<FittingSize> fitting_sizes;
+  // over_budget before refinement with no size that fits, because the skin's
+  // creases (a shrink factor near 1) need the triangles whatever the sizes:
+  // the largest shrink factor that would fit, else 0.
+  double fitting_shrink = 0;
   SurfaceMesh mesh;                // triangles oriented outward; normals and mixed cells per vertex; empty unless ok
   MeshingStats stats;
   // remesh_skin only: per vertex of `mesh`, the index of the given sample it
