@@ -209,7 +209,10 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
                    {"grading", seconds_grading}}}};
   if (!g.all_hold()) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": the mesh fails a guarantee (see below); nothing written\n"
-              << json_text(report["guarantees"]) << "\n";
+              << json_text({{"guarantees", report["guarantees"]},
+                            {"on_surface_error", report["on_surface_error"]},
+                            {"min_angle", g.quality.min_angle}})
+              << "\n";
     return ExitCode::not_met;
   }
   write_outputs(o, format, complex, result.mesh, g.quality, report, start);
