@@ -154,7 +154,7 @@ constexpr double kBytesPerTriangle = 1750;
 // (docs/math.md section 3), so its area over rho^2 counts its length over
 // rho, which grows as s / (1-s), whatever the size options. The constant is
 // fitted on pept, 3al1 and 1ubi at s = 0.99-0.9999 (measured over estimated
-// 0.85-1.33, docs/benchmarks.md); kCreaseRadius is where the measured counts
+// 0.85-1.33; 0.75 on pept at 0.999981, docs/benchmarks.md); kCreaseRadius is where the measured counts
 // begin to pass the area terms (s = 0.99, whose necks bend at about 0.01 A).
 constexpr double kCreaseRadius = 0.01;  // Angstrom
 constexpr double kTrianglesPerCreaseArea = 0.086;

@@ -52,7 +52,7 @@ SkinAreaProfile skin_area_profile(const SkinComplex& complex, const SkinAreaOpti
 // meshing"); at larger shrink factors the estimate can fall short, never over.
 inline constexpr double kTriangleEstimateSpread = 1.25;
 // Where the skin's creases make most of the estimate (a shrink factor near
-// 1), measured counts ran 0.85-1.33 times it (docs/benchmarks.md).
+// 1), measured counts ran 0.75-1.33 times it (docs/benchmarks.md).
 inline constexpr double kCreaseEstimateSpread = 1.4;
 
 struct TriangleEstimate {
@@ -60,13 +60,15 @@ struct TriangleEstimate {
   double size_bound = 0;     // of which where the size bound binds (epsilon, edge length, min and max size)
   double distance_bound = 0; // of which where the distance tolerance binds
   double per_cell = 0;       // of which the few every small patch takes whatever its size
-  double creases = 0;        // of which along necks sharper than the size floor (a shrink factor near 1),
+  double creases = 0;        // of which along necks bending at radii under 0.01 A (a shrink factor near 1),
                              // whatever the size options
   double peak_bytes = 0;     // expected peak memory of mesh_skin (the complex excluded)
   // The low end, what a refusal is judged by: the area terms alone (the per
   // cell term overcounts meshes coarser than the default, whose triangles
   // span several cells) less the spread.
-  double low() const { return (size_bound + distance_bound + creases) / kTriangleEstimateSpread; }
+  double low() const {
+    return (size_bound + distance_bound) / kTriangleEstimateSpread + creases / kCreaseEstimateSpread;
+  }
   double low_peak_bytes() const { return triangles > 0 ? peak_bytes * low() / triangles : 0; }
 };
 
