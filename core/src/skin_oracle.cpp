@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -19,9 +20,79 @@ double OracleResult::distance() const {
   return g > 0 ? std::abs(value) / g : std::abs(value) > 0 ? INFINITY : 0.0;
 }
 
+// Balls bucketed by centre in a uniform grid of about one ball per cell: the
+// balls within a distance of a point are found without a pass over all of
+// them. Only a speed-up: which balls a query visits never changes an
+// answer's certificate (SkinOracle::evaluate bounds the rest).
+class BallGrid {
+ public:
+  explicit BallGrid(const std::vector<Ball>& balls) {
+    lower_ = upper_ = balls.front().center;
+    for (const Ball& b : balls) {
+      lower_ = lower_.cwiseMin(b.center);
+      upper_ = upper_.cwiseMax(b.center);
+      max_weight_ = std::max(max_weight_, b.weight);
+    }
+    const Eigen::Vector3d extent = (upper_ - lower_).cwiseMax(1e-9);
+    const double n = static_cast<double>(balls.size());
+    cell_ = std::max(std::cbrt(extent.prod() / n), 1e-3 * extent.maxCoeff());
+    for (int a = 0; a < 3; ++a) dims_[a] = std::min(1 + static_cast<int>(extent[a] / cell_), 1 << 10);
+    const size_t cells = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
+    start_.assign(cells + 1, 0);
+    std::vector<size_t> cell_of(balls.size());
+    for (size_t i = 0; i < balls.size(); ++i) ++start_[(cell_of[i] = cell_index(balls[i].center)) + 1];
+    for (size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+    index_.resize(balls.size());
+    std::vector<size_t> fill(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < balls.size(); ++i) index_[fill[cell_of[i]]++] = static_cast<int>(i);
+  }
+  double max_weight() const { return max_weight_; }
+  // Calls visit(i) for every ball whose centre lies within `radius` of x (and
+  // a few more). Returns false, visiting nothing, when the query would cover
+  // most of the grid: the caller then passes over every ball.
+  template <class Visit>
+  bool within(const Eigen::Vector3d& x, double radius, Visit visit) const {
+    std::array<int, 3> from{}, to{};
+    double covered = 1;
+    for (int a = 0; a < 3; ++a) {
+      from[a] = cell_along(a, x[a] - radius);
+      to[a] = cell_along(a, x[a] + radius);
+      if (!(x[a] + radius >= lower_[a] - cell_ && x[a] - radius <= upper_[a] + cell_)) return true;  // none near
+      covered *= to[a] - from[a] + 1;
+    }
+    if (!(covered * 2 < static_cast<double>(start_.size()))) return false;
+    for (int i = from[0]; i <= to[0]; ++i)
+      for (int j = from[1]; j <= to[1]; ++j)
+        for (int k = from[2]; k <= to[2]; ++k) {
+          const size_t c = (static_cast<size_t>(i) * dims_[1] + j) * dims_[2] + k;
+          for (size_t e = start_[c]; e < start_[c + 1]; ++e) visit(index_[e]);
+        }
+    return true;
+  }
+
+ private:
+  // Clamped in floating point before the cast: a far point or a huge radius
+  // must not overflow the integer.
+  int cell_along(int axis, double coordinate) const {
+    const double at = std::floor((coordinate - lower_[axis]) / cell_);
+    return static_cast<int>(std::clamp(std::isnan(at) ? 0.0 : at, 0.0, static_cast<double>(dims_[axis] - 1)));
+  }
+  size_t cell_index(const Eigen::Vector3d& p) const {
+    std::array<size_t, 3> at{};
+    for (int a = 0; a < 3; ++a) at[a] = static_cast<size_t>(cell_along(a, p[a]));
+    return (at[0] * dims_[1] + at[1]) * dims_[2] + at[2];
+  }
+  Eigen::Vector3d lower_, upper_;
+  double cell_ = 1, max_weight_ = -INFINITY;
+  std::array<int, 3> dims_{};
+  std::vector<size_t> start_;  // balls of cell c: index_[start_[c] .. start_[c+1])
+  std::vector<int> index_;
+};
+
 SkinOracle::SkinOracle(std::vector<Ball> balls, double shrink) : balls_(std::move(balls)), shrink_(shrink) {
   if (balls_.empty()) contract_error("SkinOracle needs at least one ball");
   if (!(shrink > 0 && shrink < 1)) contract_error("shrink factor must lie in (0,1)");
+  grid_ = std::make_shared<const BallGrid>(balls_);
 }
 
 namespace {
@@ -204,24 +275,58 @@ std::vector<double> powers(const std::vector<Ball>& balls, const Eigen::Vector3d
 
 }  // namespace
 
+namespace {
+
+// Beyond this distance from x no ball's multiplier g_k can fall below mu:
+// g_k = -2(1-s) <r, z_k - x> + s (|z_k - x|^2 - w_k)
+//     >= s d^2 - 2(1-s)|r| d - s w_max   (d = |z_k - x|),
+// which passes mu for d beyond the larger root of s d^2 - b d - c.
+double certification_radius(double s, const Eigen::Vector3d& r, double mu, double max_weight) {
+  const double b = 2 * (1 - s) * r.norm(), c = s * max_weight + mu;
+  const double discriminant = b * b + 4 * s * c;
+  if (!(discriminant > 0)) return 0;
+  return (b + std::sqrt(discriminant)) / (2 * s) * (1 + 1e-9) + 1e-9;
+}
+
+}  // namespace
+
 OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
   const Problem p{balls_, shrink_, x};
   const int n = static_cast<int>(balls_.size());
-  // Candidates: the balls of smallest power distance at x.
-  std::vector<int> candidates = smallest(powers(balls_, x), 24);
+  // Candidates: the balls of smallest power distance among those near x.
+  std::vector<int> near;
+  double radius = std::sqrt(std::max(grid_->max_weight(), 0.0)) + 1.0;
+  bool all = false;
+  for (int doubling = 0; doubling < 64 && near.size() < 24 && !all; ++doubling, radius *= 2) {
+    near.clear();
+    all = !grid_->within(x, radius, [&](int k) { near.push_back(k); });
+  }
+  if (all || near.empty()) {  // most of the grid, or x not a finite point
+    near.resize(static_cast<size_t>(n));
+    std::iota(near.begin(), near.end(), 0);
+  }
+  std::vector<double> near_power(near.size());
+  for (size_t a = 0; a < near.size(); ++a) near_power[a] = balls_[static_cast<size_t>(near[a])].power(x);
+  std::vector<int> candidates;
+  for (int a : smallest(near_power, 24)) candidates.push_back(near[static_cast<size_t>(a)]);
   OracleResult out;
   for (int round = 0; round < 50; ++round) {
     const Solution sol = solve_on(p, candidates);
     const Stationary st = stationary(p, sol);
     take_solution(out, st, sol, [](int ball) { return ball; });
+    // The KKT check against every ball: those beyond the certification
+    // radius pass it by the bound, the others are checked one by one.
     double violation = st.violation;
     std::vector<int> violators;
-    for (int k = 0; k < n; ++k) {
+    const auto check = [&](int k) {
       const double gap = (st.mu - p.gradient_entry(k, st.r)) / st.scale;
       if (gap > 1e-12 && std::find(candidates.begin(), candidates.end(), k) == candidates.end())
         violators.push_back(k);
       violation = std::max(violation, gap);
-    }
+    };
+    const double reach = certification_radius(shrink_, st.r, st.mu, grid_->max_weight());
+    if (!grid_->within(x, reach, check))
+      for (int k = 0; k < n; ++k) check(k);
     out.kkt_violation = violation;
     out.certified = violation < 1e-9;
     if (violators.empty()) break;

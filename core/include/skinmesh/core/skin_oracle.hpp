@@ -2,7 +2,9 @@
 //     F_B(x) = min over l in the simplex of (1-s)|x - Z l|^2 + s sum_i l_i pi_i(x).
 // A second implementation of the skin, independent of the mixed complex: it
 // never builds a triangulation. Each answer is certified by the optimality
-// (KKT) conditions checked against every ball, so tests can trust it.
+// (KKT) conditions checked against every ball (those too far from the point
+// to violate them by a bound on their distance and the largest weight, the
+// rest one by one), so tests can trust it.
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
@@ -10,10 +12,13 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <utility>
 #include <vector>
 
 namespace skinmesh {
+
+class BallGrid;  // balls bucketed by centre (skin_oracle.cpp)
 
 struct OracleResult {
   double value = 0.0;                                   // F_B(x), Angstrom^2
@@ -36,6 +41,9 @@ class SkinOracle {
  private:
   std::vector<Ball> balls_;
   double shrink_;
+  // Balls far from x are certified by a bound instead of one by one
+  // (evaluate); the grid finds the near ones.
+  std::shared_ptr<const BallGrid> grid_;
 };
 
 // The skin function of every frame of a morph (docs/math.md section 4):
