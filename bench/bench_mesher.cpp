@@ -12,7 +12,9 @@
 //   - CGAL Surface_mesher (restricted Delaunay refinement) on the same skin as
 //     an implicit surface, angle bound 30 degrees, Delaunay-ball radius bound
 //     L/sqrt(3) and distance bound 0.1 A: the criteria of the capped skinmesh
-//     run, whose size rule is "radius > L/sqrt(3)" (plus its curvature bound).
+//     run, whose size rule is "radius > L/sqrt(3)" (plus its curvature bound);
+//     once with skinmesh's complex evaluating the skin function, once with
+//     CGAL's Skin_surface_3 giving its sign (what a user of CGAL alone runs).
 // Each run is a forked child (own peak memory, a time limit). After timing,
 // the child grades its mesh with the project's grader and measures every
 // vertex with the oracle of docs/math.md section 2. Prints JSON lines, then a
@@ -31,6 +33,9 @@
 #include <CGAL/Complex_2_in_triangulation_3.h>
 #include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
 #include <CGAL/Implicit_surface_3.h>
+#include <CGAL/Skin_surface_3.h>
+#include <CGAL/Skin_surface_traits_3.h>
+#include <Eigen/Geometry>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/Surface_mesh_default_criteria_3.h>
 #include <CGAL/Surface_mesh_default_triangulation_3.h>
@@ -180,6 +185,56 @@ SurfaceMesh cgal_surface_mesher(const std::vector<Ball>& balls, double radius_bo
   return from_face_graph(mesh);
 }
 
+// CGAL's Surface_mesher on CGAL's own skin: the sign of Skin_surface_3's skin
+// function (exact, located in its triangulated mixed complex from its default
+// start) as the implicit function, which is what a user of CGAL alone runs;
+// the sign is all the mesher's bisection needs. Same balls (grow_balls off:
+// the weights are already r^2/s), same criteria as cgal_surface_mesher.
+SurfaceMesh cgal_surface_mesher_on_cgal_skin(const std::vector<Ball>& balls, double radius_bound,
+                                             double distance_bound) {
+  using Tr = CGAL::Surface_mesh_default_triangulation_3;
+  using GT = Tr::Geom_traits;
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using Skin = CGAL::Skin_surface_3<CGAL::Skin_surface_traits_3<K>>;
+  std::vector<K::Weighted_point_3> points;
+  for (const Ball& b : balls) points.emplace_back(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight);
+  const Skin skin(points.begin(), points.end(), kShrink, /*grow_balls=*/false);
+  // Skin_surface_3 locates only inside its own bounding box (beyond it the
+  // walk meets infinite cells and crashes): a point outside every ball's box
+  // is outside the skin, and is answered without it.
+  Eigen::AlignedBox3d box;
+  for (const Ball& b : balls) {
+    const double r = std::sqrt(std::max(0.0, b.weight));
+    box.extend(b.center - Eigen::Vector3d::Constant(r));
+    box.extend(b.center + Eigen::Vector3d::Constant(r));
+  }
+  struct SkinSign {
+    const Skin* skin;
+    Eigen::AlignedBox3d box;
+    double inside;  // the sign CGAL gives inside the body, so that inside is negative here
+    GT::FT operator()(const GT::Point_3& p) const {
+      if (!box.contains(Eigen::Vector3d(p.x(), p.y(), p.z()))) return 1.0;
+      const CGAL::Sign sign = skin->sign(K::Point_3(p.x(), p.y(), p.z()));
+      return sign == CGAL::ZERO ? 0.0 : (sign == CGAL::NEGATIVE ? -1.0 : 1.0) * inside;
+    }
+  };
+  const Eigen::Vector3d c = balls.front().center;
+  const double inside = skin.sign(K::Point_3(c[0], c[1], c[2])) == CGAL::NEGATIVE ? 1.0 : -1.0;
+  double reach = 0;
+  for (const Ball& b : balls) reach = std::max(reach, (b.center - c).norm() + std::sqrt(std::max(0.0, b.weight)));
+  reach += 2.0;
+  const CGAL::Implicit_surface_3<GT, SkinSign> surface(SkinSign{&skin, box, inside},
+                                                       GT::Sphere_3(GT::Point_3(c[0], c[1], c[2]), reach * reach),
+                                                       1e-7);
+  Tr triangulation;
+  CGAL::Complex_2_in_triangulation_3<Tr> c2t3(triangulation);
+  const CGAL::Surface_mesh_default_criteria_3<Tr> criteria(30.0, radius_bound, distance_bound);
+  CGAL::make_surface_mesh(c2t3, surface, criteria, CGAL::Manifold_tag());
+  CGAL::Surface_mesh<GT::Point_3> mesh;
+  CGAL::facets_in_complex_2_to_triangle_mesh(c2t3, mesh);
+  return from_face_graph(mesh);
+}
+
 SurfaceMesh ours(const std::vector<Ball>& balls, double edge_length, int threads, double contract_below = 0.0) {
   const SkinComplex complex = build_skin_complex(balls, {kShrink});
   MeshingOptions options;
@@ -239,9 +294,11 @@ int main(int argc, char** argv) {
     files = {std::string(SKINMESH_DATA_DIR) + "/pept.pdb", std::string(SKINMESH_DATA_DIR) + "/1ubi.pdb",
              std::string(SKINMESH_DATA_DIR) + "/1hpv.pdb", std::string(SKINMESH_DATA_DIR) + "/3mht.pdb"};
 
-  char uniform[64], sm[96];
+  char uniform[64], sm[96], sm_cgal_skin[128];
   std::snprintf(uniform, sizeof uniform, "skinmesh edges <= %g A", edge_length);
   std::snprintf(sm, sizeof sm, "CGAL Surface_mesher 30deg r<=%.3g d<=0.1", edge_length / std::sqrt(3.0));
+  std::snprintf(sm_cgal_skin, sizeof sm_cgal_skin, "CGAL Surface_mesher 30deg r<=%.3g d<=0.1 on CGAL Skin_surface_3",
+                edge_length / std::sqrt(3.0));
   std::vector<Row> rows;
   std::map<std::string, long> atoms_of;
   for (const std::string& file : files) {
@@ -263,8 +320,12 @@ int main(int argc, char** argv) {
         {"CGAL skin 0 subdiv", [&] { return test::cgal_skin_mesh(balls, kShrink, 0); }},
         {"CGAL skin 1 subdiv", [&] { return test::cgal_skin_mesh(balls, kShrink, 1); }},
     };
-    if (surface_mesher)
+    if (surface_mesher) {
       methods.emplace_back(sm, [&] { return cgal_surface_mesher(balls, edge_length / std::sqrt(3.0), 0.1); });
+      methods.emplace_back(sm_cgal_skin, [&] {
+        return cgal_surface_mesher_on_cgal_skin(balls, edge_length / std::sqrt(3.0), 0.1);
+      });
+    }
     for (const auto& [method, make] : methods) {
       if (!only.empty() && method.find(only) == std::string::npos) continue;
       std::fprintf(stderr, "%s: %s ...\n", name.c_str(), method.c_str());
@@ -293,12 +354,20 @@ int main(int argc, char** argv) {
   // Speed ratio at the same criteria: Surface_mesher time over skinmesh uniform time.
   std::printf("\n");
   for (const auto& [name, atoms] : atoms_of) {
-    const Row *u = nullptr, *s = nullptr;
+    const Row *u = nullptr, *s = nullptr, *cgal_skin = nullptr, *adaptive = nullptr;
     for (const Row& r : rows)
       if (r.molecule == name && r.outcome.status == "ok") {
         if (r.method == uniform) u = &r;
         if (r.method == sm) s = &r;
+        if (r.method == sm_cgal_skin) cgal_skin = &r;
+        if (r.method == "skinmesh adaptive") adaptive = &r;
       }
+    for (const Row* ours_row : {adaptive, u})
+      if (ours_row && cgal_skin)
+        std::printf("%s (%ld atoms): CGAL Surface_mesher on CGAL's Skin_surface_3 takes %.2fx the time of %s "
+                    "(%.2fx its triangles)\n",
+                    name.c_str(), atoms, cgal_skin->outcome.m.seconds / ours_row->outcome.m.seconds,
+                    ours_row->method.c_str(), cgal_skin->outcome.m.triangles / ours_row->outcome.m.triangles);
     if (u && s) {
       const Measured &a = s->outcome.m, &b = u->outcome.m;
       std::printf(
