@@ -349,6 +349,11 @@ TEST_CASE("extreme but legal inputs are refused at once, naming the sizes that w
   refused("mesh " + ball.path(), "big_ball.xyzr", "this would fit: --max-size ");
   refused("mesh " + pept + " --tolerance 1e-300", "pept.pdb", "this would fit: --tolerance ");
   refused("mesh " + pept + " --max-memory 0.001", "pept.pdb", "more than the memory allows");
+  // A weight of 1e8 (a skin sphere of radius 7,071 A) and a 0.001 A edge
+  // length: the estimate, not only the lower bound, so that the sizes are named.
+  skinmesh::test::TempFile heavy("heavy.wpts", "0 0 0 100000000\n");
+  refused("mesh " + heavy.path(), "heavy.wpts", "this would fit: --max-size ");
+  refused("mesh " + pept + " --edge-length 0.001", "pept.pdb", "this would fit: --edge-length ");
   // Necks sharper than any size: only a smaller shrink factor helps.
   refused("mesh " + pept + " --shrink 0.999999", "pept.pdb", "this would fit: --shrink 0.99");
   // volume sets the surface sizes by --epsilon and --edge-length only, and names only those.

@@ -233,7 +233,10 @@ TEST_CASE("mesher options: uniform edge length, a smaller angle bound, the budge
   fine.max_triangles = static_cast<long>(at_least) - 1;
   const SkinMeshResult refused = mesh_skin(ball, fine);
   CHECK(refused.status == MeshingStatus::over_budget);
-  CHECK(refused.message.find("at least") != std::string::npos);  // refused up front, not by refinement
+  // Refused up front (by the estimate, which comes first and names sizes, or
+  // by this lower bound), not by refinement.
+  CHECK(refused.stats.seeds == 0);
+  CHECK(refused.message.find("triangles at these sizes") != std::string::npos);
   fine.edge_length = 0.001;  // pept at a thousandth of an Angstrom: refused at once
   CHECK(mesh_skin(complex, fine).status == MeshingStatus::over_budget);
 }

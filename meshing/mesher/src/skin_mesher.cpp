@@ -296,11 +296,12 @@ void Refiner::refine() {
     Cell_handle c;
     int i0, i1, i2;
     if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) continue;
-    const Cell_handle n = c->neighbor(6 - i0 - i1 - i2);
+    const int facet_index = 6 - i0 - i1 - i2;
+    const Cell_handle n = c->neighbor(facet_index);
     const unsigned sc = c->info().value, sn = n->info().value;
     if (!((sc == e.stamp_c && sn == e.stamp_n) || (sc == e.stamp_n && sn == e.stamp_c))) {
       const bool force = e.force;
-      e = evaluate(Facet(c, 6 - i0 - i1 - i2));  // its Voronoi edge changed: look again
+      e = evaluate(Facet(c, facet_index));  // its Voronoi edge changed: look again
       if (e.crossings > 0 && (e.defect != TriangleDefect::none || force)) {
         e.force = force;
         queue.push(e);
@@ -811,6 +812,17 @@ SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSam
     empty.message = "the skin of this ball set is empty: no ball has a positive weight";
     return empty;
   }
+  // The estimate from the skin's area first, for its refusal names the sizes
+  // that fit (mesh_skin only: a morph frame's remesh starts from a mesh that
+  // fitted, and the profile would cost it time); the lower bound after it
+  // guards remesh_skin too.
+  double expected_triangles = 0;
+  if (!samples) {
+    const SkinAreaProfile profile = skin_area_profile(complex);
+    const TriangleEstimate estimate = estimate_triangles(profile, options);
+    expected_triangles = estimate.triangles;
+    if (auto refused = refuse_if_unaffordable(profile, estimate, complex.shrink(), options)) return *refused;
+  }
   if (const double least = triangles_at_least(complex, options); least > static_cast<double>(options.max_triangles)) {
     SkinMeshResult refused;
     refused.status = MeshingStatus::over_budget;
@@ -819,15 +831,6 @@ SkinMeshResult run_refiner(const SkinComplex& complex, const std::vector<SkinSam
                       std::to_string(options.max_triangles) +
                       " triangles; raise the budget or ask for larger triangles (a larger edge length or maximum size)";
     return refused;
-  }
-  // The estimate from the skin's area (mesh_skin only: a morph frame's remesh
-  // starts from a mesh that fitted, and the profile would cost it time).
-  double expected_triangles = 0;
-  if (!samples) {
-    const SkinAreaProfile profile = skin_area_profile(complex);
-    const TriangleEstimate estimate = estimate_triangles(profile, options);
-    expected_triangles = estimate.triangles;
-    if (auto refused = refuse_if_unaffordable(profile, estimate, complex.shrink(), options)) return *refused;
   }
   detail::Refiner refiner(complex, options);
   refiner.expect_vertices(expected_triangles / 2);  // a closed surface mesh: about two triangles per vertex
