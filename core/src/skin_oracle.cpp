@@ -16,6 +16,7 @@
 namespace skinmesh {
 
 double OracleResult::distance() const {
+  if (std::isnan(value)) return INFINITY;  // no answer (a point that is not finite): never "on the skin"
   const double g = gradient.norm();
   return g > 0 ? std::abs(value) / g : std::abs(value) > 0 ? INFINITY : 0.0;
 }
@@ -291,6 +292,12 @@ double certification_radius(double s, const Eigen::Vector3d& r, double mu, doubl
 }  // namespace
 
 OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
+  if (!x.allFinite()) {  // no answer to certify (the maxima below would pass NaN over)
+    OracleResult none;
+    none.value = NAN;
+    none.kkt_violation = INFINITY;
+    return none;
+  }
   const Problem p{balls_, shrink_, x};
   const int n = static_cast<int>(balls_.size());
   // Candidates: the balls of smallest power distance among those near x.
@@ -325,7 +332,7 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
       violation = std::max(violation, gap);
     };
     const double reach = certification_radius(shrink_, st.r, st.mu, grid_->max_weight());
-    if (!grid_->within(x, reach, check))
+    if (!std::isfinite(reach) || !grid_->within(x, reach, check))  // no bound: check all
       for (int k = 0; k < n; ++k) check(k);
     out.kkt_violation = violation;
     out.certified = violation < 1e-9;

@@ -119,6 +119,36 @@ TEST_CASE("one ball: the skin is the sphere of radius sqrt(s w)", "[skin]") {
   CHECK(sc.value(Eigen::Vector3d(5, 2, 3)) > 0);
 }
 
+// The oracle checks near balls one by one and far ones by a bound
+// (docs/math.md section 2), found in a grid of centres. With one ball the skin
+// function is |x - z|^2 - s w exactly; points far outside the grid, and a
+// point that is not finite, must neither hang nor be certified wrongly (a far
+// point once overflowed the grid's integer cell index and looped for ever).
+TEST_CASE("the oracle: one ball exactly, far points, a point that is not finite", "[skin][oracle]") {
+  const double s = 0.5, w = 4.0;
+  const Eigen::Vector3d z(1, 2, 3);
+  const SkinOracle one({{z, w}}, s);
+  for (const Eigen::Vector3d& x : {Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(2.4, 2, 3), Eigen::Vector3d(1e6, -3e7, 2),
+                                   Eigen::Vector3d(-1e300, 0, 0)}) {
+    INFO(x.transpose());
+    const OracleResult o = one.evaluate(x);
+    CHECK(o.certified);
+    CHECK(o.value == Approx((x - z).squaredNorm() - s * w).epsilon(1e-12));
+  }
+  const OracleResult not_finite = one.evaluate(Eigen::Vector3d(NAN, 0, 0));
+  CHECK_FALSE(not_finite.certified);
+  CHECK(not_finite.distance() == INFINITY);
+  // Many balls: far points are outside every ball's reach, and the value is
+  // the least power distance's skin value there, certified.
+  const auto balls = balls_from_molecule(read_molecule(test::data_file("pept.pdb")), s);
+  const SkinOracle oracle(balls, s);
+  for (const Eigen::Vector3d& x : {Eigen::Vector3d(1e4, 0, 0), Eigen::Vector3d(0, -1e8, 3e7)}) {
+    const OracleResult o = oracle.evaluate(x);
+    CHECK(o.certified);
+    CHECK(o.value > 0);
+  }
+}
+
 // Regression: at skin points next to four nearly coplanar centres ~100 A from
 // the origin, the oracle's KKT system used to be judged singular from the
 // absolute Gram matrix, and its active-set loop stalled uncertified (3mht,
