@@ -65,7 +65,7 @@ struct TriangleEstimate {
   double peak_bytes = 0;     // expected peak memory of mesh_skin (the complex excluded)
   // The low end, what a refusal is judged by: the area terms alone (the per
   // cell term overcounts meshes coarser than the default, whose triangles
-  // span several cells) less the spread.
+  // span several cells) less their spread, the crease term less its own.
   double low() const {
     return (size_bound + distance_bound) / kTriangleEstimateSpread + creases / kCreaseEstimateSpread;
   }
