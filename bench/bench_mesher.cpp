@@ -153,11 +153,34 @@ SurfaceMesh from_face_graph(const Mesh& m) {
   return out;
 }
 
+using SurfaceTr = CGAL::Surface_mesh_default_triangulation_3;
+using SurfaceGT = SurfaceTr::Geom_traits;
+
+// CGAL's Surface_mesher (30 degrees, the given radius and distance bounds,
+// Manifold_tag) on the implicit surface `function` < 0, inside a sphere
+// around the first atom (inside the body, where the function is negative).
+template <class Function>
+SurfaceMesh surface_mesher_on(const Function& function, const std::vector<Ball>& balls, double radius_bound,
+                              double distance_bound) {
+  const Eigen::Vector3d c = balls.front().center;
+  double reach = 0;
+  for (const Ball& b : balls) reach = std::max(reach, (b.center - c).norm() + std::sqrt(std::max(0.0, b.weight)));
+  reach += 2.0;
+  const CGAL::Implicit_surface_3<SurfaceGT, Function> surface(
+      function, SurfaceGT::Sphere_3(SurfaceGT::Point_3(c[0], c[1], c[2]), reach * reach), 1e-7);
+  SurfaceTr triangulation;
+  CGAL::Complex_2_in_triangulation_3<SurfaceTr> c2t3(triangulation);
+  const CGAL::Surface_mesh_default_criteria_3<SurfaceTr> criteria(30.0, radius_bound, distance_bound);
+  CGAL::make_surface_mesh(c2t3, surface, criteria, CGAL::Manifold_tag());
+  CGAL::Surface_mesh<SurfaceGT::Point_3> mesh;
+  CGAL::facets_in_complex_2_to_triangle_mesh(c2t3, mesh);
+  return from_face_graph(mesh);
+}
+
 // CGAL's Surface_mesher on F (our mixed complex evaluates it exactly; the
 // oracle that grades the result is independent of it).
 SurfaceMesh cgal_surface_mesher(const std::vector<Ball>& balls, double radius_bound, double distance_bound) {
-  using Tr = CGAL::Surface_mesh_default_triangulation_3;
-  using GT = Tr::Geom_traits;
+  using GT = SurfaceGT;
   const SkinComplex complex = build_skin_complex(balls, {kShrink});
   struct SkinFunction {
     const SkinComplex* complex;
@@ -168,21 +191,7 @@ SurfaceMesh cgal_surface_mesher(const std::vector<Ball>& balls, double radius_bo
       return e.value;
     }
   };
-  // Bounding sphere around the first atom (inside the body: F < 0 there).
-  const Eigen::Vector3d c = balls.front().center;
-  double reach = 0;
-  for (const Ball& b : balls) reach = std::max(reach, (b.center - c).norm() + std::sqrt(std::max(0.0, b.weight)));
-  reach += 2.0;
-  const CGAL::Implicit_surface_3<GT, SkinFunction> surface(SkinFunction{&complex},
-                                                           GT::Sphere_3(GT::Point_3(c[0], c[1], c[2]), reach * reach),
-                                                           1e-7);
-  Tr triangulation;
-  CGAL::Complex_2_in_triangulation_3<Tr> c2t3(triangulation);
-  const CGAL::Surface_mesh_default_criteria_3<Tr> criteria(30.0, radius_bound, distance_bound);
-  CGAL::make_surface_mesh(c2t3, surface, criteria, CGAL::Manifold_tag());
-  CGAL::Surface_mesh<GT::Point_3> mesh;
-  CGAL::facets_in_complex_2_to_triangle_mesh(c2t3, mesh);
-  return from_face_graph(mesh);
+  return surface_mesher_on(SkinFunction{&complex}, balls, radius_bound, distance_bound);
 }
 
 // CGAL's Surface_mesher on CGAL's own skin: the sign of Skin_surface_3's skin
@@ -192,8 +201,7 @@ SurfaceMesh cgal_surface_mesher(const std::vector<Ball>& balls, double radius_bo
 // the weights are already r^2/s), same criteria as cgal_surface_mesher.
 SurfaceMesh cgal_surface_mesher_on_cgal_skin(const std::vector<Ball>& balls, double radius_bound,
                                              double distance_bound) {
-  using Tr = CGAL::Surface_mesh_default_triangulation_3;
-  using GT = Tr::Geom_traits;
+  using GT = SurfaceGT;
   using K = CGAL::Exact_predicates_inexact_constructions_kernel;
   using Skin = CGAL::Skin_surface_3<CGAL::Skin_surface_traits_3<K>>;
   std::vector<K::Weighted_point_3> points;
@@ -220,19 +228,7 @@ SurfaceMesh cgal_surface_mesher_on_cgal_skin(const std::vector<Ball>& balls, dou
   };
   const Eigen::Vector3d c = balls.front().center;
   const double inside = skin.sign(K::Point_3(c[0], c[1], c[2])) == CGAL::NEGATIVE ? 1.0 : -1.0;
-  double reach = 0;
-  for (const Ball& b : balls) reach = std::max(reach, (b.center - c).norm() + std::sqrt(std::max(0.0, b.weight)));
-  reach += 2.0;
-  const CGAL::Implicit_surface_3<GT, SkinSign> surface(SkinSign{&skin, box, inside},
-                                                       GT::Sphere_3(GT::Point_3(c[0], c[1], c[2]), reach * reach),
-                                                       1e-7);
-  Tr triangulation;
-  CGAL::Complex_2_in_triangulation_3<Tr> c2t3(triangulation);
-  const CGAL::Surface_mesh_default_criteria_3<Tr> criteria(30.0, radius_bound, distance_bound);
-  CGAL::make_surface_mesh(c2t3, surface, criteria, CGAL::Manifold_tag());
-  CGAL::Surface_mesh<GT::Point_3> mesh;
-  CGAL::facets_in_complex_2_to_triangle_mesh(c2t3, mesh);
-  return from_face_graph(mesh);
+  return surface_mesher_on(SkinSign{&skin, box, inside}, balls, radius_bound, distance_bound);
 }
 
 SurfaceMesh ours(const std::vector<Ball>& balls, double edge_length, int threads, double contract_below = 0.0) {
