@@ -1,5 +1,6 @@
 #include "local_repair.hpp"
 
+#include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -211,6 +212,14 @@ void compact(const SurfaceMesh& merged, size_t old_vertices, LocalRepair& out) {
 
 }  // namespace
 
+bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,
+                     const MeshingOptions& criteria) {
+  const auto restricted = restricted_triangle(complex, corners, criteria.tolerance, hint);
+  if (!restricted || triangle_defect(complex, *restricted, criteria) != TriangleDefect::none) return false;
+  const Eigen::Vector3d outward = complex.evaluate(restricted->ball_center, restricted->ball_cell).gradient;
+  return (corners[1] - corners[0]).cross(corners[2] - corners[0]).dot(outward) > 0;
+}
+
 std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
                                     const std::vector<Triangle>& triangles, const MeshingOptions& criteria) {
   std::vector<char> bad(triangles.size(), 0);
@@ -220,9 +229,7 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
       const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
                                                    mesh.vertices[static_cast<size_t>(t[1])],
                                                    mesh.vertices[static_cast<size_t>(t[2])]};
-      const auto restricted =
-          restricted_triangle(complex, corners, criteria.tolerance, mesh.cells[static_cast<size_t>(t[0])]);
-      bad[i] = !restricted || triangle_defect(complex, *restricted, criteria) != TriangleDefect::none;
+      bad[i] = !triangle_passes(complex, corners, mesh.cells[static_cast<size_t>(t[0])], criteria);
     }
   });
   return bad;
