@@ -72,18 +72,13 @@ std::vector<double> frame_times(int n) {
   return t;
 }
 
-// How a morph column repairs its frames: the defaults, whole frames only,
-// or the defaults with local edits first (MorphOptions::edit_repair).
-enum class Repairs { defaults, whole_frames, edits_first };
-
-Column run_morph(const Pair& p, int frames, Repairs repairs) {
+Column run_morph(const Pair& p, int frames, bool local_repair) {
   const MorphOracle oracle(p.source, p.target, kShrink);
   const std::vector<double> ts = frame_times(frames);
   Column c;
   const auto start = Clock::now();
   MorphOptions options;
-  if (repairs == Repairs::whole_frames) options.local_repair_share = 0;
-  options.edit_repair = repairs == Repairs::edits_first;
+  if (!local_repair) options.local_repair_share = 0;
   Morph morph = prepare_morph(p.source, p.target, ts.front(), options);
   c.seconds_first = seconds_since(start);
   c.seconds += c.seconds_first;
@@ -230,9 +225,8 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::function<Column()>>> columns;
     if (cgal) columns.emplace_back("a CGAL skin, all m*n pairs", [&] { return run_cgal(p, sample); });
     columns.emplace_back("b skinmesh rebuild, live pairs", [&] { return run_rebuilds(p, sample); });
-    columns.emplace_back("c morph", [&] { return run_morph(p, frames, Repairs::defaults); });
-    columns.emplace_back("c' morph, whole-frame repairs only", [&] { return run_morph(p, frames, Repairs::whole_frames); });
-    columns.emplace_back("c'' morph, local edits first", [&] { return run_morph(p, frames, Repairs::edits_first); });
+    columns.emplace_back("c morph", [&] { return run_morph(p, frames, true); });
+    columns.emplace_back("c' morph, whole-frame repairs only", [&] { return run_morph(p, frames, false); });
     for (const auto& [name, task] : columns) {
       if (!only.empty() && name.find(only) == std::string::npos) continue;
       std::fprintf(stderr, "%s: %s ...\n", p.name.c_str(), name.c_str());

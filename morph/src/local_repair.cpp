@@ -1,6 +1,5 @@
 #include "local_repair.hpp"
 
-#include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -215,9 +214,8 @@ void compact(const SurfaceMesh& merged, size_t old_vertices, LocalRepair& out) {
 bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,
                      const MeshingOptions& criteria) {
   const auto restricted = restricted_triangle(complex, corners, criteria.tolerance, hint);
-  if (!restricted || triangle_defect(complex, *restricted, criteria) != TriangleDefect::none) return false;
-  const Eigen::Vector3d outward = complex.evaluate(restricted->ball_center, restricted->ball_cell).gradient;
-  return (corners[1] - corners[0]).cross(corners[2] - corners[0]).dot(outward) > 0;
+  return restricted && triangle_defect(complex, *restricted, criteria) == TriangleDefect::none &&
+         faces_outward(complex, *restricted);
 }
 
 std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,

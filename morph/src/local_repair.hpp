@@ -38,9 +38,9 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, 
                            const LocalRepairOptions& options);
 
 // Whether a triangle of a frame meets the criteria (restricted_triangle,
-// triangle_defect) and faces the way the skin's normal does at its surface
-// ball centre: the criteria alone do not see a triangle that transport
-// turned over (a vertex moved across its neighbours). Not its corners'
+// triangle_defect) and faces outward (faces_outward): the criteria alone do
+// not see a triangle that transport turned over (a vertex moved across its
+// neighbours). Judged at the surface ball centre, not by its corners'
 // normals: across a thin neck a good triangle's corner normals can turn
 // past a right angle from its own. hint: a cell near the triangle.
 bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,

@@ -4,7 +4,6 @@
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/morph/transport.hpp"
 
-#include "edit_repair.hpp"
 #include "local_repair.hpp"
 
 #include <tbb/blocked_range.h>
@@ -139,47 +138,6 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
   return true;
 }
 
-// The failing triangles mended one by one by flips, splits and
-// contractions (edit_repair.hpp), and those no edit mends remeshed in
-// patches (local_repair.hpp); false when either does not finish.
-bool Morph::repair_by_edits(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing) {
-  detail::EditRepairOptions edit;
-  edit.crowded_below = options_.crowded_below;
-  detail::EditRepair r = detail::repair_by_edits(next, moved, failing, options_.frames, edit);
-  if (!r.ok) return false;
-  std::vector<long> origin = std::move(r.origin);
-  SurfaceMesh mesh = std::move(r.mesh);
-  if (r.stuck > 0) {
-    detail::LocalRepairOptions local;
-    local.crowded_below = options_.crowded_below;
-    detail::LocalRepair patched =
-        detail::repair_locally(next, mesh, r.failing, options_.repair_criteria(), options_.frames, local);
-        if (!patched.ok) return false;
-    for (long& o : patched.origin) o = o >= 0 ? origin[static_cast<size_t>(o)] : -1;
-    origin = std::move(patched.origin);
-    mesh = std::move(patched.mesh);
-    frame_.stats.patch_triangles = patched.patch_triangles;
-    frame_.stats.repairs += patched.repairs;
-  }
-  std::vector<long> ids(origin.size());
-  long kept = 0;
-  for (size_t v = 0; v < ids.size(); ++v) {
-    ids[v] = origin[v] >= 0 ? frame_.ids[static_cast<size_t>(origin[v])] : next_id_++;
-    kept += origin[v] >= 0;
-  }
-  FrameStats& s = frame_.stats;
-  s.repaired = true;
-  s.flips = r.flips;
-  s.splits = r.splits;
-  s.contractions = r.contractions;
-  s.inserted = static_cast<long>(ids.size()) - kept;
-  s.removed = static_cast<long>(moved.vertices.size()) - kept;
-  s.repairs += r.flips + r.splits + r.contractions;
-  frame_.mesh = std::move(mesh);
-  frame_.ids = std::move(ids);
-  return true;
-}
-
 // Remeshes the frame from the transported vertices not dropped; false when
 // the mesher cannot (then the caller rebuilds from scratch).
 bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
@@ -282,12 +240,9 @@ const MorphFrame& Morph::advance_to(double t) {
     frame_.mesh = std::move(moved);  // ids stay: every vertex survives
   } else {
     const auto repair_start = Clock::now();
-    const bool quiet = stats.events == 0 && stats.lost == 0;
-    const bool local =
-        quiet && stats.bad_triangles <= options_.local_repair_share * static_cast<double>(failing.size());
-    const bool mended = quiet && options_.edit_repair && repair_by_edits(next, moved, failing);
-    if (!mended && !(local && repair_locally(next, moved, failing))) {
-      frame_.stats = stats;  // what a failed attempt counted
+    const bool local = stats.events == 0 && stats.lost == 0 &&
+                       stats.bad_triangles <= options_.local_repair_share * static_cast<double>(failing.size());
+    if (!(local && repair_locally(next, moved, failing))) {
       frame_.stats.crowded = mark_crowded(next, moved, drop);
       remesh_or_rebuild(next, moved, drop);
     }

@@ -306,14 +306,15 @@ TEST_CASE("restricted_triangle judges the mesher's own triangles as the mesher d
   // Every triangle of a finished mesh met every criterion with its surface
   // ball centre on its Voronoi edge, which lies on its normal line within
   // 0.7 x tolerance of its circumcentre: looked up along that line, without
-  // the Delaunay triangulation, each must pass again.
+  // the Delaunay triangulation, each must pass again, and face outward;
+  // turned over, each still passes the criteria but faces inward.
   for (const char* name : {"pept.pdb", "1ubi.pdb"}) {
     INFO(name);
     const SkinComplex complex = build_skin_complex(molecule_balls(data_file(name)), {0.5});
     const MeshingOptions options;
     const SkinMeshResult r = mesh_skin(complex, options);
     REQUIRE(r.status == MeshingStatus::ok);
-    long failed = 0, missing = 0;
+    long failed = 0, missing = 0, inward = 0, turned_passing = 0, turned_outward = 0;
     for (const auto& t : r.mesh.triangles) {
       const std::array<Eigen::Vector3d, 3> corners{r.mesh.vertices[static_cast<size_t>(t[0])],
                                                    r.mesh.vertices[static_cast<size_t>(t[1])],
@@ -325,11 +326,20 @@ TEST_CASE("restricted_triangle judges the mesher's own triangles as the mesher d
       }
       const TriangleDefect d = triangle_defect(complex, *restricted, options);
       failed += d != TriangleDefect::none;
+      inward += !faces_outward(complex, *restricted);
+      // The same triangle turned over: the criteria cannot tell, the orientation can.
+      const auto turned = restricted_triangle(complex, {corners[0], corners[2], corners[1]}, options.tolerance,
+                                              r.mesh.cells[static_cast<size_t>(t[0])]);
+      turned_passing += turned && triangle_defect(complex, *turned, options) == TriangleDefect::none;
+      turned_outward += turned && faces_outward(complex, *turned);
     }
-    INFO(missing << " triangles without a crossing, " << failed << " failing a criterion, of "
-                 << r.mesh.triangles.size());
+    INFO(missing << " triangles without a crossing, " << failed << " failing a criterion, " << inward
+                 << " facing inward, of " << r.mesh.triangles.size());
     CHECK(missing == 0);
     CHECK(failed == 0);
+    CHECK(inward == 0);
+    CHECK(turned_passing == static_cast<long>(r.mesh.triangles.size()));
+    CHECK(turned_outward == 0);
   }
   // Under stricter criteria the same triangles fail: finer sizing, a tighter
   // distance tolerance.

@@ -78,6 +78,12 @@ TriangleDefect triangle_defect(const SkinComplex& complex, const RestrictedTrian
   return TriangleDefect::none;
 }
 
+bool faces_outward(const SkinComplex& complex, const RestrictedTriangle& triangle) {
+  const auto& c = triangle.corners;
+  const Eigen::Vector3d outward = complex.evaluate(triangle.ball_center, triangle.ball_cell).gradient;
+  return (c[1] - c[0]).cross(c[2] - c[0]).dot(outward) > 0;
+}
+
 double target_edge_length(const SkinComplex& complex, const Eigen::Vector3d& x, int cell,
                           const MeshingOptions& options) {
   // The curvature-relative size is what keeps the topology (a sample dense

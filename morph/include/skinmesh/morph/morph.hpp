@@ -53,15 +53,6 @@ struct MorphOptions {
   // model 1 -> 3 and pept -> 3al1, 30 frames: with 3-4% failing, local
   // repair took 0.28 and 0.71 s a frame against 0.14 and 0.60 s). 0: never.
   double local_repair_share = 0.01;
-  // true: failing triangles are first mended one by one by local edits
-  // (edge flips, splits at new skin points, contractions of crowded edges,
-  // folds moved back), whose cost follows the failing triangles; those no
-  // edit mends are remeshed in patches, and only where that fails is the
-  // frame remeshed as above. Off by default: on real pairs it is slower so
-  // far (bench_morph, pept -> 3al1 over 100 frames: 0.33 s a frame against
-  // 0.26 s remeshing whole frames), since most frames hold a topology event
-  // (remeshed whole either way) and half the patch repairs of folds fail.
-  bool edit_repair = false;
   // Repairs (local and whole-frame) refine to stricter criteria than frames
   // are accepted at, so that a repaired triangle has room to move before it
   // fails again: the angle bound raised by this much (at most 30 degrees),
@@ -86,8 +77,7 @@ struct FrameStats {
   bool remeshed = false;       // the whole frame was remeshed from its transported vertices
   long inserted = 0;           // new vertices (refinement and seeds)
   long removed = 0;            // vertices of the previous frame not in this one
-  long repairs = 0;            // local edits, or refinement insertions at failing triangles
-  long flips = 0, splits = 0, contractions = 0;  // local edits (splits insert, contractions remove a vertex)
+  long repairs = 0;            // refinement insertions, each at a failing triangle
   bool full_rebuild = false;   // the frame was meshed from scratch (repair failed)
   double seconds = 0;          // the whole frame
   double seconds_repair = 0;   // of which remeshing (or rebuilding)
@@ -128,7 +118,6 @@ class Morph {
   void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
-  bool repair_by_edits(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing);
   bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing);
   long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
 

@@ -106,6 +106,12 @@ std::optional<RestrictedTriangle> restricted_triangle(const SkinComplex& complex
 TriangleDefect triangle_defect(const SkinComplex& complex, const RestrictedTriangle& triangle,
                                const MeshingOptions& options);
 
+// Whether the triangle, corners in their order, faces the way the skin's
+// gradient points at its surface ball centre. The criteria above do not see
+// orientation: a triangle turned over (a morph's transport moved a corner
+// across its neighbours) meets them as well as the right one does.
+bool faces_outward(const SkinComplex& complex, const RestrictedTriangle& triangle);
+
 // The target edge length (Angstrom) at a skin point x of `cell`.
 double target_edge_length(const SkinComplex& complex, const Eigen::Vector3d& x, int cell,
                           const MeshingOptions& options);
