@@ -290,6 +290,18 @@ SkinComplex SkinComplex::with_balls(std::vector<Ball> balls) const {
   return SkinComplexBuilder::moved(*this, std::move(balls));
 }
 
+SkinComplex SkinComplex::with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known) const {
+  SkinComplex sc = SkinComplexBuilder::moved(*this, std::move(balls));
+  for (const KnownCell& k : known) {
+    if (k.cell < 0 || k.cell >= static_cast<int>(cells_.size())) contract_error("with_balls: a known cell out of range");
+    MixedCell& cell = sc.cells_[static_cast<size_t>(k.cell)];
+    cell.center = k.center;
+    cell.R2 = k.R2;
+    cell.P = cells_[static_cast<size_t>(k.cell)].P;
+  }
+  return sc;
+}
+
 bool SkinComplex::same_flat_cells(const SkinComplex& other) const {
   if (cells_.size() != other.cells_.size()) return false;
   for (size_t c = 0; c < cells_.size(); ++c)

@@ -40,9 +40,9 @@ Morph::Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<Bal
       middle_(std::move(middle)),
       current_(middle_),
       options_(options) {
-  const std::vector<CellSize> sizes = cell_sizes(middle_, source_, target_, pairs_);
+  sizes_ = cell_sizes(middle_, source_, target_, pairs_);
   const MorphOracle oracle(source_, target_, options.shrink);
-  events_ = critical_events(topology_events(sizes), sizes, middle_, pairs_, oracle);
+  events_ = critical_events(topology_events(sizes_), sizes_, middle_, pairs_, oracle);
 }
 
 void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t) {
@@ -219,15 +219,14 @@ const MorphFrame& Morph::advance_to(double t) {
   stats.events = std::count_if(events_.begin(), events_.end(),
                                [&](const TopologyEvent& e) { return e.t > t_ && e.t <= t; });
   if (t == 1.0 || !on_overlay_) {
-    SkinComplex next = t == 1.0 ? build_skin_complex(target_, {options_.shrink})
-                                : middle_.with_balls(interpolated_balls(source_, target_, pairs_, t));
+    SkinComplex next = t == 1.0 ? build_skin_complex(target_, {options_.shrink}) : overlay_at(t);
     reseat(next, stats);
     current_ = std::move(next);
     on_overlay_ = t < 1.0;
     finish_frame(t, start);
     return frame_;
   }
-  const SkinComplex next = middle_.with_balls(interpolated_balls(source_, target_, pairs_, t));
+  const SkinComplex next = overlay_at(t);
   SurfaceMesh moved = frame_.mesh;
   std::vector<char> drop = move_vertices(next, moved, stats);
   std::vector<char> failing;
@@ -253,6 +252,20 @@ const MorphFrame& Morph::advance_to(double t) {
   return frame_;
 }
 
+// The overlay complex at t: middle_ moved to B(t), each overlay cell's
+// centre and size from its curves (eq. 17-18: z(t) affine, R2(t) quadratic)
+// and its directions from B(1/2). Recomputed from the balls instead, a cell
+// near t = 0 or 1 is a sliver and lost digits: on 2k39 model 1 -> 3 a frame
+// at t = 0.999 had a vertex 4.2e-9 A off the skin by the morph oracle and by
+// CGAL's skin sign, and the command refused t = 0.999 (1.27e-8 A); with the
+// curves, 1.2e-13 A (bench/morph_precision).
+SkinComplex Morph::overlay_at(double t) const {
+  std::vector<SkinComplex::KnownCell> known;
+  for (size_t c = 0; c < sizes_.size(); ++c)
+    if (sizes_[c].overlay_cell) known.push_back({static_cast<int>(c), sizes_[c].center(t), sizes_[c].at(t)});
+  return middle_.with_balls(interpolated_balls(source_, target_, pairs_, t), known);
+}
+
 std::vector<std::array<int, 2>> Morph::vertex_atoms() const {
   const SurfaceMesh& mesh = frame_.mesh;
   std::vector<std::array<int, 2>> atoms(mesh.vertices.size());
@@ -274,7 +287,7 @@ Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t
   const auto start = Clock::now();
   morph.on_overlay_ = t0 > 0;
   morph.current_ = t0 > 0
-                       ? morph.middle_.with_balls(interpolated_balls(morph.source_, morph.target_, morph.pairs_, t0))
+                       ? morph.overlay_at(t0)
                        : build_skin_complex(morph.source_, {options.shrink});
   morph.t_ = t0;
   morph.rebuild(morph.current_, options.first_criteria(), t0);

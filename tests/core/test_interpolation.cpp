@@ -5,6 +5,8 @@
 
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 
 #include <catch2/catch.hpp>
@@ -100,4 +102,27 @@ TEST_CASE("live pairs are the non-hidden balls of the full m*n set", "[interpola
   for (const BallPair& p : non_hidden_of_all_pairs(m1, m1))
     if (p.source == p.target) own.push_back(p);
   CHECK(live_pairs(m1, m1) == own);
+}
+
+TEST_CASE("with_balls with known cells: those take the given centre and size and keep their directions",
+          "[interpolation]") {
+  const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
+  const auto m2 = test::centred_model(test::data_file("2k39_3models.pdb"), 2);
+  const auto live = live_pairs(m1, m2);
+  const SkinComplex middle = build_skin_complex(interpolated_balls(m1, m2, live, 0.5), {0.5});
+  int edge = 0;
+  while (middle.cell(edge).dim != 1) ++edge;
+  const Eigen::Vector3d centre(1.5, -2.0, 0.25);
+  const SkinComplex moved = middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{edge, centre, 0.75}});
+  const SkinComplex plain = middle.with_balls(interpolated_balls(m1, m2, live, 0.3));
+  CHECK(moved.cell(edge).center == centre);
+  CHECK(moved.cell(edge).R2 == 0.75);
+  CHECK(moved.cell(edge).P == middle.cell(edge).P);
+  // Every other cell as with_balls alone makes it.
+  const int other = edge + 1;
+  CHECK(moved.cell(other).center == plain.cell(other).center);
+  CHECK(moved.cell(other).R2 == plain.cell(other).R2);
+  CHECK_THROWS_AS(middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{-1, centre, 0.0}}), ContractError);
+  const int past = static_cast<int>(middle.cells().size());
+  CHECK_THROWS_AS(middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{past, centre, 0.0}}), ContractError);
 }

@@ -114,6 +114,19 @@ class SkinComplex {
   // (0,1). Throws ContractError when the number of balls differs or a ball is
   // not finite.
   SkinComplex with_balls(std::vector<Ball> balls) const;
+  // with_balls, except that each listed cell takes the given centre and size
+  // and keeps this complex's projector P instead of recomputing them from
+  // its balls: a morph's overlay cell, whose directions are the same for
+  // every t in (0,1), whose centre is affine and whose size is quadratic in
+  // t (docs/math.md section 4). Near t = 0 or 1 such a cell is a sliver, and
+  // its geometry recomputed from its balls lost up to ~1e-8 A of the skin.
+  // Throws ContractError for a cell index out of range.
+  struct KnownCell {
+    int cell = -1;
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    double R2 = 0.0;
+  };
+  SkinComplex with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known) const;
   // Whether two complexes of one combinatorics have the same flat cells
   // (MixedCell::degenerate): a frame whose flat cells differ from the complex
   // it was moved from has left the combinatorics it was built for.

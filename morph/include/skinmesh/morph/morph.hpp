@@ -122,6 +122,7 @@ class Morph {
   long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
 
   void reseat(const SkinComplex& next, FrameStats& stats);
+  SkinComplex overlay_at(double t) const;
   void finish_frame(double t, Clock::time_point start);
 
   std::vector<Ball> source_, target_;
@@ -129,6 +130,7 @@ class Morph {
   SkinComplex middle_, current_;
   bool on_overlay_ = true;  // current_ is the overlay complex (cells numbered as middle_)
   MorphOptions options_;
+  std::vector<CellSize> sizes_;  // per cell of middle_: its size and centre as functions of t
   std::vector<TopologyEvent> events_;
   MorphFrame frame_;
   double t_ = 0;
