@@ -16,6 +16,7 @@
 // CGAL's sign bracket. CGAL gets B(t)'s balls (live pairs)
 // with centres moved by at most 1e-10 A, which it needs on B(t)'s
 // cospherical groups; that moves the skin by about as much.
+#include "cgal_reference.hpp"
 #include "morph_pairs.hpp"
 
 #include "skinmesh/core/interpolation.hpp"
@@ -31,7 +32,6 @@
 #include <memory>
 #include <cstdio>
 #include <exception>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -65,13 +65,9 @@ struct CgalSkin {
   std::unique_ptr<Skin> skin;
   int inside = 1;
   explicit CgalSkin(std::vector<Ball> balls) {
-    std::mt19937 rng(1);
-    std::uniform_real_distribution<double> u(-kJitter, kJitter);
+    balls = test::jittered(std::move(balls), kJitter);
     std::vector<K::Weighted_point_3> points;
-    for (Ball& b : balls) {
-      b.center += Eigen::Vector3d(u(rng), u(rng), u(rng));
-      points.emplace_back(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight);
-    }
+    for (const Ball& b : balls) points.emplace_back(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight);
     skin = std::make_unique<Skin>(points.begin(), points.end(), kShrink, /*grow_balls=*/false);
     const Eigen::Vector3d c = balls.front().center;
     inside = skin->sign(K::Point_3(c[0], c[1], c[2])) == CGAL::NEGATIVE ? 1 : -1;
