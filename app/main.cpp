@@ -3,12 +3,14 @@
 #include "exit_codes.hpp"
 #include "interrupt.hpp"
 
+#include "skinmesh/core/allocator.hpp"
 #include "skinmesh/core/error.hpp"
 
 #include <iostream>
 
 int main(int argc, char** argv) {
   skinmesh::app::watch_interrupts();  // first: before any thread starts
+  skinmesh::return_large_blocks_to_system();
   CLI::App app{"skinmesh: quality meshes of molecular skin surfaces"};
   app.require_subcommand(1);
   app.fallthrough();  // --json and --quiet may follow the subcommand

@@ -2,6 +2,8 @@
 // and a crash or a timeout reported instead of taking the benchmark down.
 #pragma once
 
+#include "skinmesh/core/allocator.hpp"
+
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -35,6 +37,7 @@ Forked<Result> run_forked(int timeout_seconds, const std::function<Result()>& ta
   if (pid == 0) {
     close(fds[0]);
     alarm(static_cast<unsigned>(timeout_seconds));
+    return_large_blocks_to_system();  // as the skinmesh command does
     try {
       const Result r = task();
       if (write(fds[1], &r, sizeof r) != static_cast<ssize_t>(sizeof r)) _exit(1);

@@ -282,6 +282,9 @@ struct SkinComplexBuilder {
     for (MixedCell& c : sc.cells_) compute_cell_geometry(c, sc.balls_);
     add_constraints_beyond_flat_cofaces(sc.cells_, sc.faces_, sc.face_offset_, sc.cofaces_, sc.coface_offset_);
     build_start_grid(sc);
+    // The complex outlives everything the mesher allocates: give back the
+    // growth slack of its largest list (up to half of 27 MB on 3mht).
+    sc.cells_.shrink_to_fit();
     return sc;
   }
 };

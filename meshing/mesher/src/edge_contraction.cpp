@@ -97,7 +97,7 @@ bool Refiner::try_contract(Vertex_handle a, Vertex_handle b, const Projection& t
 
 // The restricted edges shorter than contract_below times the smaller target
 // length at their ends, shortest first.
-std::vector<ShortEdge> Refiner::short_edges(const std::vector<FacetEval>& restricted) const {
+std::vector<ShortEdge> Refiner::short_edges(const FacetEvals& restricted) const {
   std::vector<ShortEdge> candidates;
   std::unordered_set<long long> listed;
   for (const FacetEval& e : restricted)
@@ -117,7 +117,7 @@ std::vector<ShortEdge> Refiner::short_edges(const std::vector<FacetEval>& restri
   return candidates;
 }
 
-long Refiner::contract_short_edges(const std::vector<FacetEval>& restricted) {
+long Refiner::contract_short_edges(const FacetEvals& restricted) {
   const unsigned pass_stamp = stamp_;
   FacetSet restricted_before;
   for (const FacetEval& e : restricted) restricted_before.insert(facet_key(e));

@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <optional>
 #include <queue>
@@ -53,18 +54,27 @@ using Facet = Delaunay::Facet;
 
 inline Eigen::Vector3d to_eigen(const K::Point_3& p) { return {p.x(), p.y(), p.z()}; }
 
-// What the Voronoi edge dual to one Delaunay facet says about it.
+// What the Voronoi edge dual to one Delaunay facet says about it. Kept for
+// every restricted facet between passes, so it is kept small (80 bytes):
+// memory per output triangle is one of the speed issue's measures.
 struct FacetEval {
   int crossings = 0;                 // of the Voronoi edge with the skin; restricted iff > 0
+  int cell = -1;                     // mixed cell of the surface Delaunay ball centre
   Eigen::Vector3d center;            // surface Delaunay ball centre (farthest crossing if several)
-  int cell = -1;                     // its mixed cell
   double radius = 0;                 // surface Delaunay ball radius
-  Eigen::Vector3d outward;           // outward skin normal direction along the Voronoi edge
+  std::array<Vertex_handle, 3> v;    // ascending ids
+  unsigned stamp_c = 0, stamp_n = 0; // of the two cells when evaluated
   TriangleDefect defect = TriangleDefect::none;
   bool force = false;                // a vertex-star repair: insert even without a defect
-  std::array<Vertex_handle, 3> v;
-  unsigned stamp_c = 0, stamp_n = 0; // of the two cells when evaluated
+  // The skin's outward side is along +(v1 - v0) x (v2 - v0): the Voronoi edge
+  // leaves the skin's inside there (dual_edge walks it along that normal).
+  bool outward_along_normal = true;
 };
+
+// Lists of restricted facets. A deque: it grows without copying itself
+// (a vector's reallocation held two copies of the largest list at once, the
+// peak of the run: 42 + 26 MB on 3mht, heaptrack).
+using FacetEvals = std::deque<FacetEval>;
 
 // A Voronoi edge dual to a Delaunay facet, from a to b along the facet's
 // normal, and the apexes of the facet's two tetrahedra (none beyond the hull).
@@ -94,7 +104,8 @@ inline FacetKey facet_key(const FacetEval& e) {
   return facet_key({e.v[0]->info().id, e.v[1]->info().id, e.v[2]->info().id});
 }
 struct FacetKeyHash {
-  size_t operator()(const FacetKey& k) const {
+  // noexcept: std::unordered_map then keeps no hash code in each node.
+  size_t operator()(const FacetKey& k) const noexcept {
     size_t h = static_cast<size_t>(k[0]);
     h = h * 0x9E3779B97F4A7C15ull ^ static_cast<size_t>(k[1]);
     return h * 0x9E3779B97F4A7C15ull ^ static_cast<size_t>(k[2]);
@@ -202,18 +213,20 @@ class Refiner {
   void push_repair(FacetEval e);  // a vertex-star repair: insert its ball centre even without a defect
   void refine();
   std::vector<Facet> star_facets(Vertex_handle v) const;  // after insert(v)
-  std::vector<FacetEval> evaluate_all(const std::vector<Facet>& facets) const;
-  bool global_pass(std::vector<FacetEval>* restricted);
-  bool repair_stars(const std::vector<FacetEval>& restricted, const std::vector<Vertex_handle>& vertices);
+  // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.
+  void keep_restricted(const std::vector<Facet>& facets, FacetEvals* restricted) const;
+  bool global_pass();
+  void keep_pass(std::vector<uint32_t> unchanged, FacetEvals fresh);
+  bool repair_stars(const FacetEvals& restricted, const std::vector<Vertex_handle>& vertices);
   std::optional<Projection> isolated_repair_point(Vertex_handle v) const;
   void local_passes();
-  SurfaceMesh extract(const std::vector<FacetEval>& restricted, std::vector<long>* origins) const;
+  SurfaceMesh extract(const FacetEvals& restricted, std::vector<long>* origins) const;
   void report(const char* stage, Report when, long pending = 0);
-  void refine_until_clean(std::vector<FacetEval>* restricted);
+  void refine_until_clean();  // then restricted_ holds the mesh
 
   // Clean-up (edge_contraction.cpp).
-  long contract_short_edges(const std::vector<FacetEval>& restricted);
-  std::vector<ShortEdge> short_edges(const std::vector<FacetEval>& restricted) const;
+  long contract_short_edges(const FacetEvals& restricted);
+  std::vector<ShortEdge> short_edges(const FacetEvals& restricted) const;
   bool try_contract(Vertex_handle a, Vertex_handle b, const Projection& target, unsigned pass_stamp,
                     const FacetSet& restricted_before, std::unordered_set<int>* touched);
   bool region_is_good(const std::vector<Vertex_handle>& region, unsigned pass_stamp,
@@ -229,9 +242,12 @@ class Refiner {
   std::vector<Cell_handle> star_;    // cells made by the last insertion
   std::vector<Vertex_handle> recent_;  // inserted since the last global or local pass
   unsigned stamp_ = 0;
-  // The restricted facets of the last global pass, by vertex ids, and the
-  // stamp then: cells stamped no later are unchanged since.
-  std::unordered_map<FacetKey, FacetEval, FacetKeyHash> pass_cache_;
+  // The restricted facets of the last global pass in the order of their keys,
+  // where each key is in that list, and the stamp then: cells stamped no later
+  // are unchanged since. One copy of each evaluation: these two are most of
+  // the refiner's memory after CGAL's triangulation.
+  FacetEvals restricted_;
+  std::unordered_map<FacetKey, uint32_t, FacetKeyHash> restricted_index_;
   unsigned last_pass_stamp_ = 0;
   bool have_pass_cache_ = false;
   Eigen::Vector3d box_center_;
