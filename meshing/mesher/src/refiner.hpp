@@ -86,6 +86,7 @@ struct DualEdge {
 
 // Whether the link of a vertex (the opposite edges of its restricted
 // triangles) is one closed cycle: the vertex star is a disk.
+bool is_single_cycle(const std::pair<int, int>* edges, size_t count);
 bool is_single_cycle(const std::vector<std::pair<int, int>>& edges);
 
 // A facet by its vertices' ids, ascending: the same key whichever cell the
@@ -255,6 +256,7 @@ class Refiner {
   double max_radius_edge_ = 1;
   int next_id_ = 0;
   int sample_ids_ = 0;  // ids below this are the given samples' indices (remesh_skin, mesh_patch)
+  std::vector<int> star_slot_;  // by vertex id: its place in repair_stars' list, else -1
   std::vector<PatchRole> roles_;  // by sample id (mesh_patch); empty for the whole skin
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();

@@ -341,32 +341,30 @@ void Refiner::refine() {
   }
 }
 
-bool is_single_cycle(const std::vector<std::pair<int, int>>& edges) {
-  if (edges.empty()) return false;
+bool is_single_cycle(const std::pair<int, int>* edges, size_t count) {
+  if (count == 0) return false;
   // One cycle: every link vertex has degree two and a walk visits every edge.
-  std::unordered_map<int, std::array<int, 2>> adjacent;
-  for (const auto& [a, b] : edges) {
-    for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}}) {
-      auto [it, fresh] = adjacent.try_emplace(x, std::array<int, 2>{{y, -1}});
-      if (!fresh) {
-        if (it->second[1] >= 0) return false;
-        it->second[1] = y;
-      }
-    }
-  }
-  for (const auto& [x, ys] : adjacent)
-    if (ys[1] < 0) return false;
-  int prev = edges[0].first, cur = edges[0].second;
-  size_t steps = 1;
-  while (cur != edges[0].first && steps <= edges.size()) {
-    const auto& ys = adjacent[cur];
-    const int next = ys[0] == prev ? ys[1] : ys[0];
-    prev = cur;
-    cur = next;
+  // Links are short (about six edges), so plain scans beat any map.
+  auto degree = [&](int x) {
+    int d = 0;
+    for (size_t k = 0; k < count; ++k) d += (edges[k].first == x) + (edges[k].second == x);
+    return d;
+  };
+  for (size_t k = 0; k < count; ++k)
+    if (degree(edges[k].first) != 2 || degree(edges[k].second) != 2) return false;
+  size_t edge = 0, steps = 1;
+  int cur = edges[0].second;
+  while (cur != edges[0].first && steps <= count) {
+    size_t next = 0;
+    while (next == edge || (edges[next].first != cur && edges[next].second != cur)) ++next;
+    cur = edges[next].first == cur ? edges[next].second : edges[next].first;
+    edge = next;
     ++steps;
   }
-  return steps == edges.size();
+  return steps == count;
 }
+
+bool is_single_cycle(const std::vector<std::pair<int, int>>& edges) { return is_single_cycle(edges.data(), edges.size()); }
 
 // Classifies every Delaunay facet (in parallel), queues the bad ones and the
 // repairs of vertex stars that are not disks. Returns true when nothing is left
@@ -516,31 +514,48 @@ std::optional<Projection> Refiner::isolated_repair_point(Vertex_handle v) const 
 
 bool Refiner::repair_stars(const FacetEvals& restricted, const std::vector<Vertex_handle>& vertices) {
   bool clean = true;
-  Links link;
-  std::unordered_map<int, int> best_facet;  // per listed vertex: its restricted facet with the largest ball
-  link.reserve(vertices.size());
-  for (const Vertex_handle& v : vertices) link[v->info().id];
-  for (int f = 0; f < static_cast<int>(restricted.size()); ++f) {
-    const FacetEval& e = restricted[static_cast<size_t>(f)];
-    const FacetKey ids{{e.v[0]->info().id, e.v[1]->info().id, e.v[2]->info().id}};
-    add_to_links(ids, LinkScope::listed_vertices, link);
-    for (int me : ids) {
-      if (!link.count(me)) continue;
-      auto [best, fresh] = best_facet.try_emplace(me, f);
-      if (!fresh && e.radius > restricted[static_cast<size_t>(best->second)].radius) best->second = f;
+  // The link of each listed vertex, in one array in the order of `vertices`
+  // (a map of vectors per vertex was 60 bytes a triangle at the global pass,
+  // the run's peak of memory). star_slot_ maps an id to its place in
+  // `vertices`; it is reset before returning.
+  if (star_slot_.size() < static_cast<size_t>(next_id_)) star_slot_.resize(static_cast<size_t>(next_id_), -1);
+  for (size_t k = 0; k < vertices.size(); ++k) star_slot_[static_cast<size_t>(vertices[k]->info().id)] = static_cast<int>(k);
+  auto slot = [&](int id) { return star_slot_[static_cast<size_t>(id)]; };
+  std::vector<int> offset(vertices.size() + 1, 0);
+  std::vector<int> best_facet(vertices.size(), -1);  // per listed vertex: its restricted facet with the largest ball
+  for (size_t f = 0; f < restricted.size(); ++f) {
+    const FacetEval& e = restricted[f];
+    for (const Vertex_handle& v : e.v) {
+      const int k = slot(v->info().id);
+      if (k < 0) continue;
+      ++offset[static_cast<size_t>(k) + 1];
+      int& best = best_facet[static_cast<size_t>(k)];
+      if (best < 0 || e.radius > restricted[static_cast<size_t>(best)].radius) best = static_cast<int>(f);
     }
   }
+  for (size_t k = 0; k < vertices.size(); ++k) offset[k + 1] += offset[k];
+  std::vector<std::pair<int, int>> link(static_cast<size_t>(offset.back()));
+  {
+    std::vector<int> filled(offset.begin(), offset.end() - 1);
+    for (const FacetEval& e : restricted) {
+      const FacetKey ids{{e.v[0]->info().id, e.v[1]->info().id, e.v[2]->info().id}};
+      for (size_t c = 0; c < 3; ++c) {
+        const int k = slot(ids[c]);
+        if (k >= 0) link[static_cast<size_t>(filled[static_cast<size_t>(k)]++)] = {ids[(c + 1) % 3], ids[(c + 2) % 3]};
+      }
+    }
+  }
+  for (const Vertex_handle& v : vertices) star_slot_[static_cast<size_t>(v->info().id)] = -1;
   std::vector<Vertex_handle> isolated;
-  for (const Vertex_handle& v : vertices) {
-    const int id = v->info().id;
-    const auto& edges = link[id];
-    if (edges.empty()) {
+  for (size_t k = 0; k < vertices.size(); ++k) {
+    const size_t edges = static_cast<size_t>(offset[k + 1] - offset[k]);
+    if (edges == 0) {
       // In a patch a point without triangles is simply left out of it.
-      if (roles_.empty()) isolated.push_back(v);
+      if (roles_.empty()) isolated.push_back(vertices[k]);
       continue;
     }
-    if (!is_single_cycle(edges)) {
-      push_repair(restricted[static_cast<size_t>(best_facet[id])]);
+    if (!is_single_cycle(&link[static_cast<size_t>(offset[k])], edges)) {
+      push_repair(restricted[static_cast<size_t>(best_facet[k])]);
       clean = false;
     }
   }
