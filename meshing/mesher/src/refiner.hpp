@@ -213,7 +213,8 @@ class Refiner {
   void push_if_bad(const FacetEval& e);
   void push_repair(FacetEval e);  // a vertex-star repair: insert its ball centre even without a defect
   void refine();
-  std::vector<Facet> star_facets(Vertex_handle v) const;  // after insert(v)
+  std::optional<Vertex_handle> refine_one(FacetEval e, unsigned refine_start, std::vector<FacetEval>* requeue);
+  std::vector<Facet> batch_facets(const std::vector<Vertex_handle>& batch, unsigned since) const;
   // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.
   void keep_restricted(const std::vector<Facet>& facets, FacetEvals* restricted) const;
   bool global_pass();

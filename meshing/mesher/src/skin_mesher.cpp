@@ -245,32 +245,6 @@ void Refiner::push_repair(FacetEval e) {
   pending_.push_back(e);
 }
 
-// Every facet of the star of a new vertex is new or has a new Voronoi edge;
-// each is listed once (the cells of the star are the ones the insertion made).
-std::vector<Facet> Refiner::star_facets(Vertex_handle v) const {
-  // A facet through v lies in two cells of the star: it is listed from the
-  // one made first. (Comparing the cells' addresses instead made the order of
-  // refinement, hence the mesh, differ from one call to the next.)
-  std::unordered_map<const void*, size_t> made;
-  made.reserve(star_.size());
-  for (size_t k = 0; k < star_.size(); ++k) made.emplace(&*star_[k], k);
-  std::vector<Facet> out;
-  for (size_t k = 0; k < star_.size(); ++k) {
-    const Cell_handle& c = star_[k];
-    const bool infinite = dt_.is_infinite(c);
-    const int iv = c->index(v);
-    for (int j = 0; j < 4; ++j) {
-      if (infinite && j != c->index(dt_.infinite_vertex())) continue;  // only its finite facet
-      if (j != iv) {
-        const auto other = made.find(&*c->neighbor(j));
-        if (other != made.end() && other->second < k) continue;
-      }
-      out.emplace_back(c, j);
-    }
-  }
-  return out;
-}
-
 void Refiner::keep_restricted(const std::vector<Facet>& facets, FacetEvals* restricted) const {
   std::vector<FacetEval> evals(facets.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, facets.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -280,64 +254,121 @@ void Refiner::keep_restricted(const std::vector<Facet>& facets, FacetEvals* rest
     if (e.crossings > 0) restricted->push_back(e);
 }
 
-// Refinement: insert the surface ball centre of the pending bad facet with the
-// largest ball, evaluate the facets of the new vertex's star, repeat. An entry
-// whose cells changed since its evaluation is evaluated again first.
+// The finite facets of the cells made since stamp `since` around the
+// vertices of `batch`, each once: a facet between two such cells is listed
+// from the one made first. Every cell made by inserting a vertex is incident
+// to it, so these are all the new cells still standing.
+std::vector<Facet> Refiner::batch_facets(const std::vector<Vertex_handle>& batch, unsigned since) const {
+  std::vector<Cell_handle> cells;
+  for (const Vertex_handle& v : batch) dt_.incident_cells(v, std::back_inserter(cells));
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  std::vector<Facet> out;
+  for (const Cell_handle& c : cells) {
+    const unsigned stamp = c->info().value;
+    if (stamp <= since) continue;  // not made by this batch (cannot happen; kept as a guard)
+    const bool infinite = dt_.is_infinite(c);
+    for (int j = 0; j < 4; ++j) {
+      if (infinite && j != c->index(dt_.infinite_vertex())) continue;  // only its finite facet
+      const unsigned other = c->neighbor(j)->info().value;
+      if (other > since && other != kFreshCell && other < stamp) continue;  // listed from the neighbour
+      out.emplace_back(c, j);
+    }
+  }
+  return out;
+}
+
+// One queued bad facet: its surface ball centre inserted (the new vertex is
+// returned), or nothing. An entry whose cells changed since its evaluation is
+// dropped when its newer cell was made during this refinement (refine
+// evaluates every facet of the cells it makes, and queued it then if bad), or
+// evaluated again and, if still to do, put in `requeue`.
+std::optional<Vertex_handle> Refiner::refine_one(FacetEval e, unsigned refine_start, std::vector<FacetEval>* requeue) {
+  Cell_handle c;
+  int i0, i1, i2;
+  if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) return std::nullopt;
+  const int facet_index = 6 - i0 - i1 - i2;
+  const Cell_handle n = c->neighbor(facet_index);
+  const unsigned sc = c->info().value, sn = n->info().value;
+  if (!((sc == e.stamp_c && sn == e.stamp_n) || (sc == e.stamp_n && sn == e.stamp_c))) {
+    const unsigned newer = std::max(sc, sn);
+    if (newer > refine_start && newer != kFreshCell && !e.force) return std::nullopt;
+    const bool force = e.force;
+    e = evaluate(Facet(c, facet_index));  // its Voronoi edge changed: look again
+    if (e.crossings > 0 && (e.defect != TriangleDefect::none || force)) {
+      e.force = force;
+      requeue->push_back(e);
+    }
+    return std::nullopt;
+  }
+  if (e.radius < 1e-9) return std::nullopt;  // cannot happen for a proper triangle; never insert a duplicate
+  // The surface Delaunay ball is empty in exact arithmetic. Near a Voronoi
+  // vertex on the skin two Voronoi edges cross it at almost the same point;
+  // after one is inserted the other must not be (a near-duplicate vertex
+  // would send refinement chasing it).
+  const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
+  if ((to_eigen(nearest->point()) - e.center).norm() < 0.5 * e.radius) return std::nullopt;
+  // A patch grows no further than its context: a point nearest a context
+  // vertex would mesh skin the rest of the mesh covers already.
+  if (!active(nearest->info().id)) return std::nullopt;
+  switch (e.defect) {
+    case TriangleDefect::topology: ++stats_.inserted_topology; break;
+    case TriangleDefect::size: ++stats_.inserted_size; break;
+    case TriangleDefect::distance: ++stats_.inserted_distance; break;
+    case TriangleDefect::shape: ++stats_.inserted_shape; break;
+    case TriangleDefect::none: ++stats_.inserted_topology; break;  // forced: a vertex star repair
+  }
+  const int before = next_id_;
+  const Vertex_handle v = insert(e.center, e.cell, c);
+  if (next_id_ == before) return std::nullopt;  // the point is a sample already
+  return v;
+}
+
+// Refinement: insert the surface ball centres of the pending bad facets,
+// largest ball first, in batches; evaluate the facets of the cells each batch
+// made (in parallel) and queue the bad ones; repeat until none is left.
 void Refiner::refine() {
   // Ties broken by the facet's vertex ids: CGAL's containers are ordered by
   // memory addresses in places, and the order of refinement must not be.
   auto smaller = [](const FacetEval& a, const FacetEval& b) {
     return a.radius < b.radius || (a.radius == b.radius && facet_key(a) > facet_key(b));
   };
-  std::priority_queue<FacetEval, std::vector<FacetEval>, decltype(smaller)> queue(smaller, std::move(pending_));
+  std::vector<FacetEval> heap = std::move(pending_);
   pending_.clear();
-  while (!queue.empty()) {
-    FacetEval e = queue.top();
-    queue.pop();
-    Cell_handle c;
-    int i0, i1, i2;
-    if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) continue;
-    const int facet_index = 6 - i0 - i1 - i2;
-    const Cell_handle n = c->neighbor(facet_index);
-    const unsigned sc = c->info().value, sn = n->info().value;
-    if (!((sc == e.stamp_c && sn == e.stamp_n) || (sc == e.stamp_n && sn == e.stamp_c))) {
-      const bool force = e.force;
-      e = evaluate(Facet(c, facet_index));  // its Voronoi edge changed: look again
-      if (e.crossings > 0 && (e.defect != TriangleDefect::none || force)) {
-        e.force = force;
-        queue.push(e);
-      }
-      continue;
+  std::make_heap(heap.begin(), heap.end(), smaller);
+  auto push = [&](const FacetEval& e) {
+    heap.push_back(e);
+    std::push_heap(heap.begin(), heap.end(), smaller);
+  };
+  const unsigned refine_start = stamp_;
+  // Insertion is serial (CGAL's); evaluation, most of the time, is not. A
+  // batch of insertions lets the evaluations of their stars run together.
+  constexpr size_t kBatch = 256;
+  std::vector<Vertex_handle> batch;
+  std::vector<FacetEval> requeue;
+  while (!heap.empty()) {
+    batch.clear();
+    const unsigned batch_start = stamp_;
+    while (!heap.empty() && batch.size() < kBatch) {
+      std::pop_heap(heap.begin(), heap.end(), smaller);
+      const FacetEval e = heap.back();
+      heap.pop_back();
+      requeue.clear();
+      if (const std::optional<Vertex_handle> v = refine_one(e, refine_start, &requeue)) batch.push_back(*v);
+      for (const FacetEval& r : requeue) push(r);
     }
-    if (e.radius < 1e-9) continue;  // cannot happen for a proper triangle; never insert a duplicate
-    // The surface Delaunay ball is empty in exact arithmetic. Near a Voronoi
-    // vertex on the skin two Voronoi edges cross it at almost the same point;
-    // after one is inserted the other must not be (a near-duplicate vertex
-    // would send refinement chasing it).
-    const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
-    if ((to_eigen(nearest->point()) - e.center).norm() < 0.5 * e.radius) continue;
-    // A patch grows no further than its context: a point nearest a context
-    // vertex would mesh skin the rest of the mesh covers already.
-    if (!active(nearest->info().id)) continue;
-    switch (e.defect) {
-      case TriangleDefect::topology: ++stats_.inserted_topology; break;
-      case TriangleDefect::size: ++stats_.inserted_size; break;
-      case TriangleDefect::distance: ++stats_.inserted_distance; break;
-      case TriangleDefect::shape: ++stats_.inserted_shape; break;
-      case TriangleDefect::none: ++stats_.inserted_topology; break;  // forced: a vertex star repair
+    const std::vector<Facet> facets = batch_facets(batch, batch_start);
+    std::vector<FacetEval> evals(facets.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, facets.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t k = r.begin(); k != r.end(); ++k)
+        if (roles_.empty() || active(facet_key(facets[k]))) evals[k] = evaluate(facets[k]);
+    });
+    for (size_t k = 0; k < facets.size(); ++k) {
+      if (!roles_.empty() && !active(facet_key(facets[k]))) continue;
+      if (evals[k].crossings > 0 && evals[k].defect != TriangleDefect::none) push(evals[k]);
     }
-    const int before = next_id_;
-    const Vertex_handle v = insert(e.center, e.cell, c);
-    if (next_id_ == before) continue;  // the point is a sample already
-    for (const Facet& f : star_facets(v)) {
-      if (!roles_.empty() && !active(facet_key(f))) continue;
-      const FacetEval te = evaluate(f);
-      if (te.crossings > 0 && te.defect != TriangleDefect::none) queue.push(te);
-    }
-    if ((next_id_ & 1023) == 0) {
-      check_budget();
-      report("refining", Report::throttled, static_cast<long>(queue.size()));
-    }
+    check_budget();
+    report("refining", Report::throttled, static_cast<long>(heap.size()));
   }
 }
 
