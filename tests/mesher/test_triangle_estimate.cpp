@@ -154,7 +154,7 @@ TEST_CASE("extreme legal inputs are refused at once with the estimate", "[estima
   }
   SECTION("more memory than allowed") {
     MeshingOptions options;
-    options.max_memory_bytes = 1e6;
+    options.max_memory_bytes = 5e5;
     const SkinMeshResult refused = mesh_skin(complex_of("pept.pdb"), options);
     INFO(refused.message);
     REQUIRE(refused.status == MeshingStatus::over_budget);

@@ -145,7 +145,7 @@ namespace {
 constexpr double kTrianglesPerSizeArea = 1.3;
 constexpr double kTrianglesPerDistanceArea = 1.0;
 constexpr double kTrianglesPerCell = 1.7;
-constexpr double kBytesPerTriangle = 1750;
+constexpr double kBytesPerTriangle = 560;  // bench_estimate: 495-559 on meshes above 100,000 triangles
 // Creases: where a hyperboloid patch bends more sharply than the sizes go
 // (radius of curvature under kCreaseRadius, far below the default size floor
 // of 0.05 A), the refinement for topology (one crossing per normal line,
