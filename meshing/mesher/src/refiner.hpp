@@ -149,6 +149,9 @@ struct RefinementStopped {
   MeshingStats stats = {};  // so far
 };
 
+// Refinement goes tile by tile (refine): cubes of this edge, Angstrom.
+constexpr double kRefinementTile = 20.0;
+
 class Refiner {
  public:
   Refiner(const SkinComplex& complex, const MeshingOptions& options) : complex_(complex), options_(options) {
@@ -213,6 +216,8 @@ class Refiner {
   void push_if_bad(const FacetEval& e);
   void push_repair(FacetEval e);  // a vertex-star repair: insert its ball centre even without a defect
   void refine();
+  // The refinement tile holding p, as its Morton code (tiles of kRefinementTile).
+  uint64_t tile_of(const Eigen::Vector3d& p) const;
   std::optional<Vertex_handle> refine_one(FacetEval e, unsigned refine_start, std::vector<FacetEval>* requeue);
   std::vector<Facet> batch_facets(const std::vector<Vertex_handle>& batch, unsigned since) const;
   // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.

@@ -327,10 +327,39 @@ std::optional<Vertex_handle> Refiner::refine_one(FacetEval e, unsigned refine_st
 // Refinement: insert the surface ball centres of the pending bad facets,
 // largest ball first, in batches; evaluate the facets of the cells each batch
 // made (in parallel) and queue the bad ones; repeat until none is left.
+// Bits of x (21 of them) spread to every third bit: one coordinate of a
+// Morton code.
+static uint64_t spread_by_three(uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffull;
+  x = (x | x << 16) & 0x1f0000ff0000ffull;
+  x = (x | x << 8) & 0x100f00f00f00f00full;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+
+uint64_t Refiner::tile_of(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d q = (p - box_center_) / kRefinementTile + Eigen::Vector3d::Constant(1 << 20);
+  uint64_t code = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double clamped = std::clamp(std::floor(q[k]), 0.0, double((1 << 21) - 1));
+    code |= spread_by_three(static_cast<uint64_t>(clamped)) << k;
+  }
+  return code;
+}
+
 void Refiner::refine() {
-  // Ties broken by the facet's vertex ids: CGAL's containers are ordered by
-  // memory addresses in places, and the order of refinement must not be.
-  auto smaller = [](const FacetEval& a, const FacetEval& b) {
+  // Tile by tile along a Morton curve, and in a tile the largest ball first.
+  // Within a tile this is the usual order; across tiles it keeps the
+  // triangulation's working set small (a 3mht lattice of 8 copies cost 1.6
+  // times as much per triangle as one copy when the whole queue was taken by
+  // size). Ties broken by the facet's vertex ids: CGAL's containers are
+  // ordered by memory addresses in places, and the order of refinement must
+  // not be.
+  auto smaller = [this](const FacetEval& a, const FacetEval& b) {
+    const uint64_t ta = tile_of(a.center), tb = tile_of(b.center);
+    if (ta != tb) return ta > tb;
     return a.radius < b.radius || (a.radius == b.radius && facet_key(a) > facet_key(b));
   };
   std::vector<FacetEval> heap = std::move(pending_);
