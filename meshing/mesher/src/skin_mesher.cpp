@@ -448,8 +448,7 @@ bool Refiner::global_pass() {
     if (have_pass_cache_) {
       const Cell_handle c = f->first, n = c->neighbor(f->second);
       if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
-        const auto it = restricted_index_.find(facet_key(*f));
-        if (it != restricted_index_.end()) unchanged.push_back(it->second);
+        if (const std::optional<uint32_t> k = find_restricted(facet_key(*f))) unchanged.push_back(*k);
         continue;
       }
     }
@@ -477,11 +476,35 @@ bool Refiner::global_pass() {
   return repair_stars(restricted_, star_checked_only(std::move(all)));
 }
 
+void Refiner::index_restricted() {
+  restricted_start_.assign(static_cast<size_t>(next_id_) + 1, 0);
+  restricted_rest_.resize(restricted_.size());
+  for (size_t k = 0; k < restricted_.size(); ++k) {
+    const FacetKey ids = facet_key(restricted_[k]);
+    ++restricted_start_[static_cast<size_t>(ids[0]) + 1];
+    restricted_rest_[k] = {ids[1], ids[2]};
+  }
+  for (size_t i = 1; i < restricted_start_.size(); ++i) restricted_start_[i] += restricted_start_[i - 1];
+}
+
+void Refiner::forget_restricted_index() {
+  restricted_start_ = {};
+  restricted_rest_ = {};
+}
+
+std::optional<uint32_t> Refiner::find_restricted(const FacetKey& ids) const {
+  const size_t first = static_cast<size_t>(ids[0]);
+  if (first + 1 >= restricted_start_.size()) return std::nullopt;  // a vertex newer than the index
+  for (uint32_t k = restricted_start_[first]; k < restricted_start_[first + 1]; ++k)
+    if (restricted_rest_[k] == std::pair<int, int>{ids[1], ids[2]}) return k;
+  return std::nullopt;
+}
+
 // The new pass's restricted facets: the `unchanged` entries of restricted_
 // (compacted in place; the others name facets that are gone, whose vertex
 // handles must not be touched) and the `fresh` evaluations.
 void Refiner::keep_pass(std::vector<uint32_t> unchanged, FacetEvals fresh) {
-  restricted_index_ = {};  // frees its nodes before the list grows
+  forget_restricted_index();
   std::sort(unchanged.begin(), unchanged.end());
   size_t kept = 0;
   for (const uint32_t k : unchanged) restricted_[kept++] = restricted_[k];
@@ -492,8 +515,7 @@ void Refiner::keep_pass(std::vector<uint32_t> unchanged, FacetEvals fresh) {
   // the repairs are then the same in every call and every process.
   std::sort(restricted_.begin(), restricted_.end(),
             [](const FacetEval& a, const FacetEval& b) { return facet_key(a) < facet_key(b); });
-  restricted_index_.reserve(restricted_.size());
-  for (size_t k = 0; k < restricted_.size(); ++k) restricted_index_.emplace(facet_key(restricted_[k]), static_cast<uint32_t>(k));
+  index_restricted();
   last_pass_stamp_ = stamp_;
   have_pass_cache_ = true;
 }
@@ -692,8 +714,7 @@ void Refiner::local_passes() {
       if (!active(key)) return true;
       const Cell_handle c = f.first, n = c->neighbor(f.second);
       if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
-        const auto it = restricted_index_.find(key);
-        if (it != restricted_index_.end()) restricted.push_back(restricted_[it->second]);
+        if (const std::optional<uint32_t> k = find_restricted(key)) restricted.push_back(restricted_[*k]);
         return true;
       }
       const FacetEval e = evaluate(f);
@@ -752,7 +773,7 @@ SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
     if (contract_short_edges(restricted_) > 0) refine_until_clean();
     stats_.seconds_contracting = seconds_since(contract_start);
   }
-  restricted_index_ = {};  // the passes are over: room for the mesh
+  forget_restricted_index();  // the passes are over: room for the mesh
   SkinMeshResult result;
   result.mesh = extract(restricted_, &result.origins);
   if (!samples) result.origins.clear();
