@@ -64,12 +64,14 @@ struct FacetEval {
   double radius = 0;                 // surface Delaunay ball radius
   std::array<Vertex_handle, 3> v;    // ascending ids
   unsigned stamp_c = 0, stamp_n = 0; // of the two cells when evaluated
+  uint32_t tile = 0;                 // refinement tile of the centre (Refiner::tile_of): the queue's first key
   TriangleDefect defect = TriangleDefect::none;
   bool force = false;                // a vertex-star repair: insert even without a defect
   // The skin's outward side is along +(v1 - v0) x (v2 - v0): the Voronoi edge
   // leaves the skin's inside there (dual_edge walks it along that normal).
   bool outward_along_normal = true;
 };
+static_assert(sizeof(FacetEval) <= 80, "kept for every restricted facet: keep it small");
 
 // Lists of restricted facets. A deque: it grows without copying itself
 // (a vector's reallocation held two copies of the largest list at once, the
@@ -216,8 +218,9 @@ class Refiner {
   void push_if_bad(const FacetEval& e);
   void push_repair(FacetEval e);  // a vertex-star repair: insert its ball centre even without a defect
   void refine();
-  // The refinement tile holding p, as its Morton code (tiles of kRefinementTile).
-  uint64_t tile_of(const Eigen::Vector3d& p) const;
+  // The refinement tile holding p, as its Morton code (tiles of kRefinementTile,
+  // 1,024 a side around the molecule; beyond, the outermost).
+  uint32_t tile_of(const Eigen::Vector3d& p) const;
   std::optional<Vertex_handle> refine_one(FacetEval e, unsigned refine_start, std::vector<FacetEval>* requeue);
   std::vector<Facet> batch_facets(const std::vector<Vertex_handle>& batch, unsigned since) const;
   // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.

@@ -105,6 +105,7 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
     }
   }
   e.center = hits[best].point;
+  e.tile = tile_of(e.center);
   e.cell = hits[best].cell;
   e.radius = std::sqrt(best_r2);
   e.outward_along_normal = !hits[best].entering;
@@ -339,14 +340,14 @@ static uint64_t spread_by_three(uint64_t x) {
   return x;
 }
 
-uint64_t Refiner::tile_of(const Eigen::Vector3d& p) const {
-  const Eigen::Vector3d q = (p - box_center_) / kRefinementTile + Eigen::Vector3d::Constant(1 << 20);
+uint32_t Refiner::tile_of(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d q = (p - box_center_) / kRefinementTile + Eigen::Vector3d::Constant(1 << 9);
   uint64_t code = 0;
   for (int k = 0; k < 3; ++k) {
-    const double clamped = std::clamp(std::floor(q[k]), 0.0, double((1 << 21) - 1));
+    const double clamped = std::clamp(std::floor(q[k]), 0.0, double((1 << 10) - 1));
     code |= spread_by_three(static_cast<uint64_t>(clamped)) << k;
   }
-  return code;
+  return static_cast<uint32_t>(code);  // 30 bits
 }
 
 void Refiner::refine() {
@@ -357,9 +358,8 @@ void Refiner::refine() {
   // size). Ties broken by the facet's vertex ids: CGAL's containers are
   // ordered by memory addresses in places, and the order of refinement must
   // not be.
-  auto smaller = [this](const FacetEval& a, const FacetEval& b) {
-    const uint64_t ta = tile_of(a.center), tb = tile_of(b.center);
-    if (ta != tb) return ta > tb;
+  auto smaller = [](const FacetEval& a, const FacetEval& b) {
+    if (a.tile != b.tile) return a.tile > b.tile;
     return a.radius < b.radius || (a.radius == b.radius && facet_key(a) > facet_key(b));
   };
   std::vector<FacetEval> heap = std::move(pending_);

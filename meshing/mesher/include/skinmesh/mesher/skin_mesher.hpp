@@ -82,7 +82,7 @@ struct RestrictedTriangle {
   int crossings = 1;                                         // of the dual edge with the skin
 };
 
-enum class TriangleDefect {
+enum class TriangleDefect : unsigned char {
   none,
   topology,  // the dual edge crosses the skin more than once
   size,      // surface Delaunay ball radius > target edge length / sqrt(3)
