@@ -86,6 +86,17 @@ struct DualEdge {
   std::optional<Eigen::Vector3d> apex_n;
 };
 
+// What an evaluation needs of a facet, copied out of the triangulation so
+// that it can be evaluated while the triangulation changes (refine evaluates
+// one batch while it inserts the next). Vertices are never removed during
+// refinement, and a vertex's point and info do not change after insertion.
+struct FacetShape {
+  std::array<Vertex_handle, 3> v;  // ascending ids
+  Eigen::Vector3d apex_c;          // of the cell the facet was taken from (finite)
+  std::optional<Eigen::Vector3d> apex_n;  // of the cell across; none beyond the hull
+  unsigned stamp_c = 0, stamp_n = 0;
+};
+
 // Whether the link of a vertex (the opposite edges of its restricted
 // triangles) is one closed cycle: the vertex star is a disk.
 bool is_single_cycle(const std::pair<int, int>* edges, size_t count);
@@ -208,8 +219,12 @@ class Refiner {
   }
   std::vector<Vertex_handle> star_checked_only(std::vector<Vertex_handle> vertices) const;
 
-  FacetEval evaluate(const Facet& facet) const;
-  std::optional<DualEdge> dual_edge(Cell_handle c, int i, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+  FacetShape shape_of(const Facet& facet) const;
+  // Reads nothing of the triangulation but the shape's vertices: safe while
+  // the triangulation changes elsewhere.
+  FacetEval evaluate(const FacetShape& shape) const;
+  FacetEval evaluate(const Facet& facet) const { return evaluate(shape_of(facet)); }
+  std::optional<DualEdge> dual_edge(const FacetShape& shape, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                                     const Eigen::Vector3d& p2) const;
   // Seeds closer than spacing times the target edge length to a sample are left out.
   void insert_seeds(double spacing);

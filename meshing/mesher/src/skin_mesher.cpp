@@ -18,14 +18,14 @@
 
 namespace skinmesh::detail {
 
-// The Voronoi edge dual to facet i of cell c (triangle p0 p1 p2), walked
+// The Voronoi edge dual to the facet of `shape` (triangle p0 p1 p2), walked
 // along the triangle's normal. It lies on the line through the triangle's
 // circumcentre along its normal. Computing it from the triangle, and only the
 // parameters of its ends from the two tetrahedra, keeps it accurate when a
 // tetrahedron is flat (nearly cocircular samples, common on sphere patches)
 // and its circumcentre is ill-conditioned: every point found on it is then
 // truly equidistant from the triangle's vertices. Empty for collinear samples.
-std::optional<DualEdge> Refiner::dual_edge(Cell_handle c, int i, const Eigen::Vector3d& p0,
+std::optional<DualEdge> Refiner::dual_edge(const FacetShape& shape, const Eigen::Vector3d& p0,
                                            const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) const {
   const Eigen::Vector3d u = p1 - p0, w = p2 - p0;
   const Eigen::Vector3d uxw = u.cross(w);
@@ -43,22 +43,18 @@ std::optional<DualEdge> Refiner::dual_edge(Cell_handle c, int i, const Eigen::Ve
     return numerator / (2.0 * height);
   };
   DualEdge edge;
-  edge.apex_c = to_eigen(c->vertex(i)->point());
-  double lambda_c = end_parameter(edge.apex_c), lambda_n;
-  const Cell_handle n = c->neighbor(i);
-  if (dt_.is_infinite(n)) {
-    // Convex hull facet: the Voronoi edge is a ray leaving the hull.
-    lambda_n = normal.dot(edge.apex_c - circumcenter) > 0 ? -reach : reach;
-  } else {
-    edge.apex_n = to_eigen(n->vertex(n->index(c))->point());
-    lambda_n = end_parameter(*edge.apex_n);
-  }
+  edge.apex_c = shape.apex_c;
+  edge.apex_n = shape.apex_n;
+  const double lambda_c = end_parameter(edge.apex_c);
+  // Beyond a convex hull facet the Voronoi edge is a ray leaving the hull.
+  const double lambda_n = edge.apex_n ? end_parameter(*edge.apex_n)
+                                      : (normal.dot(edge.apex_c - circumcenter) > 0 ? -reach : reach);
   edge.a = circumcenter + std::min(lambda_c, lambda_n) * normal;
   edge.b = circumcenter + std::max(lambda_c, lambda_n) * normal;
   return edge;
 }
 
-FacetEval Refiner::evaluate(const Facet& facet) const {
+FacetShape Refiner::shape_of(const Facet& facet) const {
   Cell_handle c = facet.first;
   int i = facet.second;
   if (dt_.is_infinite(c)) {
@@ -66,17 +62,29 @@ FacetEval Refiner::evaluate(const Facet& facet) const {
     i = m->index(c);
     c = m;
   }
-  FacetEval e;
-  e.stamp_c = c->info().value;
-  e.stamp_n = c->neighbor(i)->info().value;
-  for (int k = 0; k < 3; ++k) e.v[static_cast<size_t>(k)] = c->vertex((i + 1 + k) & 3);
+  FacetShape shape;
+  const Cell_handle n = c->neighbor(i);
+  shape.stamp_c = c->info().value;
+  shape.stamp_n = n->info().value;
+  shape.apex_c = to_eigen(c->vertex(i)->point());
+  if (!dt_.is_infinite(n)) shape.apex_n = to_eigen(n->vertex(n->index(c))->point());
+  for (int k = 0; k < 3; ++k) shape.v[static_cast<size_t>(k)] = c->vertex((i + 1 + k) & 3);
   // Canonical form, whichever cell the facet was reached from: vertices in
   // insertion order and the Voronoi edge walked along +normal. Near-degenerate
   // configurations then get the same answer in every pass and every process.
-  std::sort(e.v.begin(), e.v.end(), [](Vertex_handle x, Vertex_handle y) { return x->info().id < y->info().id; });
+  std::sort(shape.v.begin(), shape.v.end(),
+            [](Vertex_handle x, Vertex_handle y) { return x->info().id < y->info().id; });
+  return shape;
+}
+
+FacetEval Refiner::evaluate(const FacetShape& shape) const {
+  FacetEval e;
+  e.stamp_c = shape.stamp_c;
+  e.stamp_n = shape.stamp_n;
+  e.v = shape.v;
   const Eigen::Vector3d p0 = to_eigen(e.v[0]->point()), p1 = to_eigen(e.v[1]->point()),
                         p2 = to_eigen(e.v[2]->point());
-  const std::optional<DualEdge> edge = dual_edge(c, i, p0, p1, p2);
+  const std::optional<DualEdge> edge = dual_edge(shape, p0, p1, p2);
   if (!edge) return e;  // collinear samples: no triangle, nothing to test
   auto hits = complex_.intersect_segment(edge->a, edge->b, e.v[0]->info().cell);
   // A point inside the Voronoi edge is strictly nearer to the triangle's
