@@ -11,6 +11,7 @@
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/hilbert_sort.h>
 #include <CGAL/property_map.h>
+#include <tbb/task_group.h>
 
 #include <iomanip>
 #include <numeric>
@@ -379,11 +380,30 @@ void Refiner::refine() {
   };
   const unsigned refine_start = stamp_;
   // Insertion is serial (CGAL's); evaluation, most of the time, is not. A
-  // batch of insertions lets the evaluations of their stars run together.
+  // batch of insertions lets the evaluations of their stars run together,
+  // and they run while the next batch is inserted (from copies of the
+  // facets' shapes): the queue then takes a batch's bad facets one batch
+  // late, always at the same point, so the order of refinement does not
+  // depend on timing. An entry whose cells the next batch replaced is
+  // dropped when it comes up (refine_one): the new cells are evaluated.
   constexpr size_t kBatch = 256;
   std::vector<Vertex_handle> batch;
   std::vector<FacetEval> requeue;
-  while (!heap.empty()) {
+  std::vector<FacetShape> shapes;
+  std::vector<FacetEval> evals;
+  tbb::task_group evaluating;
+  bool in_flight = false;
+  auto collect = [&] {  // the evaluated batch's bad facets into the queue
+    evaluating.wait();
+    in_flight = false;
+    for (const FacetEval& e : evals)
+      if (e.crossings > 0 && e.defect != TriangleDefect::none) push(e);
+  };
+  while (!heap.empty() || in_flight) {
+    if (heap.empty()) {
+      collect();
+      continue;
+    }
     batch.clear();
     const unsigned batch_start = stamp_;
     while (!heap.empty() && batch.size() < kBatch) {
@@ -394,16 +414,18 @@ void Refiner::refine() {
       if (const std::optional<Vertex_handle> v = refine_one(e, refine_start, &requeue)) batch.push_back(*v);
       for (const FacetEval& r : requeue) push(r);
     }
-    const std::vector<Facet> facets = batch_facets(batch, batch_start);
-    std::vector<FacetEval> evals(facets.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, facets.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t k = r.begin(); k != r.end(); ++k)
-        if (roles_.empty() || active(facet_key(facets[k]))) evals[k] = evaluate(facets[k]);
+    std::vector<FacetShape> next;
+    for (const Facet& f : batch_facets(batch, batch_start))
+      if (roles_.empty() || active(facet_key(f))) next.push_back(shape_of(f));
+    if (in_flight) collect();
+    shapes = std::move(next);
+    evals.assign(shapes.size(), FacetEval{});
+    evaluating.run([this, &shapes, &evals] {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, shapes.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k) evals[k] = evaluate(shapes[k]);
+      });
     });
-    for (size_t k = 0; k < facets.size(); ++k) {
-      if (!roles_.empty() && !active(facet_key(facets[k]))) continue;
-      if (evals[k].crossings > 0 && evals[k].defect != TriangleDefect::none) push(evals[k]);
-    }
+    in_flight = true;
     check_budget();
     report("refining", Report::throttled, static_cast<long>(heap.size()));
   }
