@@ -729,8 +729,14 @@ void Refiner::local_passes() {
   // After a large refinement the region is most of the mesh, and one global
   // pass (which visits each facet once) is cheaper.
   const size_t most = std::max<size_t>(64, dt_.number_of_vertices() / 100);
+  // Stars a round could not check (it found bad triangles, and a star is
+  // only judged once its triangles are good) are checked in the next one:
+  // otherwise a broken star away from the next insertions waited for the
+  // next global pass (3mht: two more global passes, 0.3-0.4 s each).
+  std::vector<Vertex_handle> unchecked;
   for (int round = 0; round < 50 && !recent_.empty() && recent_.size() <= most; ++round) {
-    std::vector<Vertex_handle> region;
+    std::vector<Vertex_handle> region = std::move(unchecked);
+    unchecked.clear();
     for (const Vertex_handle& v : recent_) {
       region.push_back(v);
       dt_.finite_adjacent_vertices(v, std::back_inserter(region));
@@ -756,7 +762,12 @@ void Refiner::local_passes() {
       }
       return true;
     });
-    if (defects || !repair_stars(restricted, star_checked_only(region))) refine();
+    if (defects) {
+      unchecked = std::move(region);
+      refine();
+    } else if (!repair_stars(restricted, star_checked_only(region))) {
+      refine();
+    }
   }
 }
 
