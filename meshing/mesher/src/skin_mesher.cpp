@@ -11,6 +11,7 @@
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/hilbert_sort.h>
 #include <CGAL/property_map.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/task_group.h>
 
 #include <iomanip>
@@ -530,6 +531,35 @@ std::optional<uint32_t> Refiner::find_restricted(const FacetKey& ids) const {
   return std::nullopt;
 }
 
+// Sorts by facet key: each key computed once (a key reads three vertices),
+// the keys sorted in parallel, the evaluations then permuted in place
+// (sorting the 80-byte evaluations with keys computed per comparison was
+// 0.11-0.23 s a pass on 3mht).
+static void sort_by_key(FacetEvals& evals) {
+  std::vector<std::pair<FacetKey, uint32_t>> order(evals.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, evals.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) order[k] = {facet_key(evals[k]), static_cast<uint32_t>(k)};
+  });
+  tbb::parallel_sort(order.begin(), order.end());
+  // Entry i takes old entry order[i].second: follow each cycle once, marking
+  // a place done by pointing it at itself.
+  for (size_t i = 0; i < order.size(); ++i) {
+    if (order[i].second == i) continue;
+    FacetEval first = evals[i];
+    size_t at = i;
+    for (;;) {
+      const size_t from = order[at].second;
+      order[at].second = static_cast<uint32_t>(at);
+      if (from == i) {
+        evals[at] = first;
+        break;
+      }
+      evals[at] = evals[from];
+      at = from;
+    }
+  }
+}
+
 // The new pass's restricted facets: the `unchanged` entries of restricted_
 // (compacted in place; the others name facets that are gone, whose vertex
 // handles must not be touched) and the `fresh` evaluations.
@@ -543,8 +573,7 @@ void Refiner::keep_pass(std::vector<uint32_t> unchanged, FacetEvals fresh) {
   // In the order of their vertex ids, not of CGAL's containers (whose order
   // depends on memory addresses): the mesh, the order of its vertices and of
   // the repairs are then the same in every call and every process.
-  std::sort(restricted_.begin(), restricted_.end(),
-            [](const FacetEval& a, const FacetEval& b) { return facet_key(a) < facet_key(b); });
+  sort_by_key(restricted_);
   index_restricted();
   last_pass_stamp_ = stamp_;
   have_pass_cache_ = true;
