@@ -401,8 +401,16 @@ static CellExit segment_exit(const SkinComplex& sc, int c, const Eigen::Vector3d
 std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                             int hint) const {
   std::vector<SegmentCrossing> out;
+  intersect_segment(a, b, hint, &out);
+  return out;
+}
+
+void SkinComplex::intersect_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, int hint,
+                                    std::vector<SegmentCrossing>* crossings) const {
+  std::vector<SegmentCrossing>& out = *crossings;
+  out.clear();
   const Eigen::Vector3d dir = b - a;
-  if (dir.squaredNorm() == 0.0) return out;
+  if (dir.squaredNorm() == 0.0) return;
   int c = locate(a, hint);
   double t = 0.0;        // crossings are searched from here
   double t_floor = 0.0;  // exits are searched from here (past a point stepped over)
@@ -448,7 +456,6 @@ std::vector<SegmentCrossing> SkinComplex::intersect_segment(const Eigen::Vector3
     // A cell past a flat coface is not adjacent: find the one really there.
     c = exit.beyond ? locate(a + t * dir, exit.next) : exit.next;
   }
-  return out;
 }
 
 PrincipalCurvatures SkinComplex::curvature(const Eigen::Vector3d& x, int c) const {

@@ -86,14 +86,15 @@ struct DualEdge {
   std::optional<Eigen::Vector3d> apex_n;
 };
 
-// What an evaluation needs of a facet, copied out of the triangulation so
+// What an evaluation needs of a facet, taken out of the triangulation so
 // that it can be evaluated while the triangulation changes (refine evaluates
-// one batch while it inserts the next). Vertices are never removed during
-// refinement, and a vertex's point and info do not change after insertion.
+// one batch while it inserts the next): handles only, since the serial part
+// must stay short. Vertices are never removed during refinement, and a
+// vertex's point and info do not change after insertion.
 struct FacetShape {
-  std::array<Vertex_handle, 3> v;  // ascending ids
-  Eigen::Vector3d apex_c;          // of the cell the facet was taken from (finite)
-  std::optional<Eigen::Vector3d> apex_n;  // of the cell across; none beyond the hull
+  std::array<Vertex_handle, 3> v;  // in any order (the evaluation sorts them)
+  Vertex_handle apex_c;            // of the cell the facet was taken from (finite)
+  Vertex_handle apex_n;            // of the cell across; null beyond the hull
   unsigned stamp_c = 0, stamp_n = 0;
 };
 

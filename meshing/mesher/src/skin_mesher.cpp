@@ -45,8 +45,8 @@ std::optional<DualEdge> Refiner::dual_edge(const FacetShape& shape, const Eigen:
     return numerator / (2.0 * height);
   };
   DualEdge edge;
-  edge.apex_c = shape.apex_c;
-  edge.apex_n = shape.apex_n;
+  edge.apex_c = to_eigen(shape.apex_c->point());
+  if (shape.apex_n != Vertex_handle()) edge.apex_n = to_eigen(shape.apex_n->point());
   const double lambda_c = end_parameter(edge.apex_c);
   // Beyond a convex hull facet the Voronoi edge is a ray leaving the hull.
   const double lambda_n = edge.apex_n ? end_parameter(*edge.apex_n)
@@ -68,14 +68,9 @@ FacetShape Refiner::shape_of(const Facet& facet) const {
   const Cell_handle n = c->neighbor(i);
   shape.stamp_c = c->info().value;
   shape.stamp_n = n->info().value;
-  shape.apex_c = to_eigen(c->vertex(i)->point());
-  if (!dt_.is_infinite(n)) shape.apex_n = to_eigen(n->vertex(n->index(c))->point());
+  shape.apex_c = c->vertex(i);
+  if (!dt_.is_infinite(n)) shape.apex_n = n->vertex(n->index(c));
   for (int k = 0; k < 3; ++k) shape.v[static_cast<size_t>(k)] = c->vertex((i + 1 + k) & 3);
-  // Canonical form, whichever cell the facet was reached from: vertices in
-  // insertion order and the Voronoi edge walked along +normal. Near-degenerate
-  // configurations then get the same answer in every pass and every process.
-  std::sort(shape.v.begin(), shape.v.end(),
-            [](Vertex_handle x, Vertex_handle y) { return x->info().id < y->info().id; });
   return shape;
 }
 
@@ -84,11 +79,16 @@ FacetEval Refiner::evaluate(const FacetShape& shape) const {
   e.stamp_c = shape.stamp_c;
   e.stamp_n = shape.stamp_n;
   e.v = shape.v;
+  // Canonical form, whichever cell the facet was reached from: vertices in
+  // insertion order and the Voronoi edge walked along +normal. Near-degenerate
+  // configurations then get the same answer in every pass and every process.
+  std::sort(e.v.begin(), e.v.end(), [](Vertex_handle x, Vertex_handle y) { return x->info().id < y->info().id; });
   const Eigen::Vector3d p0 = to_eigen(e.v[0]->point()), p1 = to_eigen(e.v[1]->point()),
                         p2 = to_eigen(e.v[2]->point());
   const std::optional<DualEdge> edge = dual_edge(shape, p0, p1, p2);
   if (!edge) return e;  // collinear samples: no triangle, nothing to test
-  auto hits = complex_.intersect_segment(edge->a, edge->b, e.v[0]->info().cell);
+  thread_local std::vector<SegmentCrossing> hits;  // one buffer per thread: millions of evaluations
+  complex_.intersect_segment(edge->a, edge->b, e.v[0]->info().cell, &hits);
   // A point inside the Voronoi edge is strictly nearer to the triangle's
   // vertices than to either apex. When a tetrahedron is flat (its apex
   // cocircular with the triangle, which refinement on sphere patches does
@@ -415,8 +415,10 @@ void Refiner::refine() {
       if (const std::optional<Vertex_handle> v = refine_one(e, refine_start, &requeue)) batch.push_back(*v);
       for (const FacetEval& r : requeue) push(r);
     }
+    const std::vector<Facet> facets = batch_facets(batch, batch_start);
     std::vector<FacetShape> next;
-    for (const Facet& f : batch_facets(batch, batch_start))
+    next.reserve(facets.size());
+    for (const Facet& f : facets)
       if (roles_.empty() || active(facet_key(f))) next.push_back(shape_of(f));
     if (in_flight) collect();
     shapes = std::move(next);
