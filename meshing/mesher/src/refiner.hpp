@@ -96,6 +96,18 @@ struct FacetShape {
   Vertex_handle apex_c;            // of the cell the facet was taken from (finite)
   Vertex_handle apex_n;            // of the cell across; null beyond the hull
   unsigned stamp_c = 0, stamp_n = 0;
+  Cell_handle cell;                // the finite cell the facet was taken from, and its index there
+  int index = 0;
+};
+
+// Where a batch of refinement found a restricted facet: the next global pass
+// evaluates these again instead of every facet the batches made (3mht: 0.33
+// of 2.3 million), while both cells still stand. 24 bytes: a list of whole
+// evaluations raised 3mht's peak by 26 MB.
+struct BatchFound {
+  Cell_handle cell;  // FacetShape::cell and ::index
+  unsigned stamp_c = 0, stamp_n = 0;
+  int index = 0;
 };
 
 // Whether the link of a vertex (the opposite edges of its restricted
@@ -269,6 +281,15 @@ class Refiner {
   const MeshingOptions& options_;
   Delaunay dt_;
   std::vector<FacetEval> pending_;   // bad facets waiting for their surface ball centre
+  // Refinement's batches evaluate every facet of the cells they make: the
+  // stamps they made since the last global pass, as ranges (first, last],
+  // and the restricted facets they found there (cleaned up as cells go).
+  std::vector<std::pair<unsigned, unsigned>> batch_stamps_;
+  std::deque<BatchFound> batch_found_;
+  size_t batch_found_after_cleanup_ = 0;
+  bool made_by_batch(unsigned stamp) const;
+  bool still_stands(const BatchFound& f) const;
+  void keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals);
   std::vector<Cell_handle> star_;    // cells made by the last insertion
   std::vector<Vertex_handle> recent_;  // inserted since the last global or local pass
   unsigned stamp_ = 0;

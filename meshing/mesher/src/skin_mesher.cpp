@@ -65,6 +65,8 @@ FacetShape Refiner::shape_of(const Facet& facet) const {
     c = m;
   }
   FacetShape shape;
+  shape.cell = c;
+  shape.index = i;
   const Cell_handle n = c->neighbor(i);
   shape.stamp_c = c->info().value;
   shape.stamp_n = n->info().value;
@@ -399,6 +401,7 @@ void Refiner::refine() {
     in_flight = false;
     for (const FacetEval& e : evals)
       if (e.crossings > 0 && e.defect != TriangleDefect::none) push(e);
+    keep_batch_found(shapes, evals);
   };
   while (!heap.empty() || in_flight) {
     if (heap.empty()) {
@@ -432,6 +435,36 @@ void Refiner::refine() {
     check_budget();
     report("refining", Report::throttled, static_cast<long>(heap.size()));
   }
+  if (stamp_ > refine_start) batch_stamps_.emplace_back(refine_start, stamp_);
+}
+
+bool Refiner::made_by_batch(unsigned stamp) const {
+  // Ranges in increasing order, a few per pass.
+  auto it = std::lower_bound(batch_stamps_.begin(), batch_stamps_.end(), stamp,
+                             [](const std::pair<unsigned, unsigned>& r, unsigned x) { return r.second < x; });
+  return it != batch_stamps_.end() && stamp > it->first && stamp <= it->second && stamp != kFreshCell;
+}
+
+// Whether the facet is still there between the same two cells. A cell is
+// never changed in place by insertion, and a new cell gets a new stamp (a
+// freed cell's place is recognised by the container without reading it).
+bool Refiner::still_stands(const BatchFound& f) const {
+  if (!dt_.tds().cells().is_used(f.cell) || f.cell->info().value != f.stamp_c) return false;
+  return f.cell->neighbor(f.index)->info().value == f.stamp_n;
+}
+
+void Refiner::keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals) {
+  for (size_t k = 0; k < evals.size(); ++k)
+    if (evals[k].crossings > 0)
+      batch_found_.push_back({shapes[k].cell, shapes[k].stamp_c, shapes[k].stamp_n, shapes[k].index});
+  // Most facets found are replaced by later batches: drop those gone once
+  // the list has grown by half, so that it stays near the live restricted count.
+  if (batch_found_.size() < batch_found_after_cleanup_ + batch_found_after_cleanup_ / 2 + 65536) return;
+  batch_found_.erase(std::remove_if(batch_found_.begin(), batch_found_.end(),
+                                    [&](const BatchFound& f) { return !still_stands(f); }),
+                     batch_found_.end());
+  batch_found_.shrink_to_fit();
+  batch_found_after_cleanup_ = batch_found_.size();
 }
 
 bool is_single_cycle(const std::pair<int, int>* edges, size_t count) {
@@ -470,7 +503,9 @@ bool Refiner::global_pass() {
   // facets are kept; any other unchanged facet was not restricted). Only the
   // facets of new cells are evaluated again, in chunks: about one facet in
   // seven is restricted, and an evaluation of every facet at once was half the
-  // peak memory (1ubi: 51 of 110 MB, heaptrack).
+  // peak memory (1ubi: 51 of 110 MB, heaptrack). Of the facets refinement's
+  // batches evaluated, only the restricted ones they found are evaluated
+  // again: the others were not restricted then and are the same now.
   constexpr size_t kChunk = size_t{1} << 14;
   std::vector<Facet> facets;
   facets.reserve(kChunk);
@@ -480,10 +515,13 @@ bool Refiner::global_pass() {
     if (!roles_.empty() && !active(facet_key(*f))) continue;
     if (have_pass_cache_) {
       const Cell_handle c = f->first, n = c->neighbor(f->second);
-      if (c->info().value <= last_pass_stamp_ && n->info().value <= last_pass_stamp_) {
+      const unsigned sc = c->info().value, sn = n->info().value;
+      if (sc <= last_pass_stamp_ && sn <= last_pass_stamp_) {
         if (const std::optional<uint32_t> k = find_restricted(facet_key(*f))) unchanged.push_back(*k);
         continue;
       }
+      // Evaluated by the batch that made its newer cell: in batch_found_ if restricted.
+      if (made_by_batch(std::max(sc, sn))) continue;
     }
     facets.push_back(*f);
     if (facets.size() == kChunk) {
@@ -491,6 +529,16 @@ bool Refiner::global_pass() {
       facets.clear();
     }
   }
+  for (; !batch_found_.empty(); batch_found_.pop_front()) {
+    if (!still_stands(batch_found_.front())) continue;
+    facets.emplace_back(batch_found_.front().cell, batch_found_.front().index);
+    if (facets.size() == kChunk) {
+      keep_restricted(facets, &fresh);
+      facets.clear();
+    }
+  }
+  batch_found_after_cleanup_ = 0;
+  batch_stamps_.clear();
   keep_restricted(facets, &fresh);
   keep_pass(std::move(unchanged), std::move(fresh));
   bool clean = true;
