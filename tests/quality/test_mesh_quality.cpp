@@ -1,5 +1,6 @@
 // Mesh grading against meshes whose answers are known by construction, every
 // reader on the same mesh, and a real skin mesh from CGAL.
+#include "cgal_reference.hpp"
 #include "test_support.hpp"
 
 #include "skinmesh/core/error.hpp"
@@ -12,6 +13,7 @@
 #include <CGAL/Skin_surface_3.h>
 #include <CGAL/Skin_surface_traits_3.h>
 #include <CGAL/make_skin_surface_mesh_3.h>
+#include <Eigen/Geometry>
 
 #include <catch2/catch.hpp>
 
@@ -127,6 +129,30 @@ TEST_CASE("defects are counted: boundary, non-manifold edge, flipped triangle, i
   CHECK(qc.components == 2);
   REQUIRE(qc.self_intersections_checked);
   CHECK(qc.self_intersecting_pairs > 0);
+}
+
+TEST_CASE("self-intersections: the two halves find CGAL's pairs over the whole mesh", "[quality]") {
+  // Tori through each other in every way: side by side across the split
+  // (the median of the triangles' x), one tilted through the other, and a
+  // copy shifted a little along x, whose triangles cross their twins near
+  // every x, so that many crossing pairs straddle the split.
+  auto add = [](SurfaceMesh& to, const SurfaceMesh& from, const Eigen::Matrix3d& turn, const Eigen::Vector3d& shift) {
+    const int base = static_cast<int>(to.vertices.size());
+    for (const auto& v : from.vertices) to.vertices.push_back(turn * v + shift);
+    for (auto t : from.triangles) to.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  };
+  const SurfaceMesh ring = torus(40, 16, 3.0, 1.0);
+  const Eigen::Matrix3d same = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d tilted = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(4.0, 0, 0), Eigen::Vector3d(3.0, 0.5, 0.2), Eigen::Vector3d(0.05, 0.02, 0.3)}) {
+    SurfaceMesh both = ring;
+    add(both, ring, shift.x() == 3.0 ? tilted : same, shift);
+    const long expected = test::cgal_self_intersecting_pairs(both);
+    CAPTURE(shift.transpose(), expected);
+    REQUIRE(expected > 0);
+    CHECK(count_self_intersections(both) == expected);
+  }
+  CHECK(count_self_intersections(ring) == 0);
 }
 
 TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {

@@ -4,10 +4,12 @@
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polyhedron_3.h>
 #include <CGAL/Skin_surface_3.h>
 #include <CGAL/Skin_surface_polyhedral_items_3.h>
 #include <CGAL/mesh_skin_surface_3.h>
+#include <CGAL/Surface_mesh.h>
 #include <CGAL/subdivide_skin_surface_mesh_3.h>
 
 #include <map>
@@ -42,6 +44,20 @@ SurfaceMesh cgal_skin_mesh(const std::vector<Ball>& balls, double shrink, int su
     mesh.triangles.push_back(t);
   }
   return mesh;
+}
+
+long cgal_self_intersecting_pairs(const SurfaceMesh& mesh) {
+  using Mesh = CGAL::Surface_mesh<K::Point_3>;
+  Mesh sm;
+  std::vector<Mesh::Vertex_index> handle;
+  for (const Eigen::Vector3d& p : mesh.vertices) handle.push_back(sm.add_vertex(K::Point_3(p.x(), p.y(), p.z())));
+  for (const auto& t : mesh.triangles)
+    if (sm.add_face(handle[static_cast<size_t>(t[0])], handle[static_cast<size_t>(t[1])],
+                    handle[static_cast<size_t>(t[2])]) == Mesh::null_face())
+      return -1;
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  CGAL::Polygon_mesh_processing::self_intersections(sm, std::back_inserter(pairs));
+  return static_cast<long>(pairs.size());
 }
 
 std::vector<double> distances_to_mesh(const SurfaceMesh& mesh, const std::vector<Eigen::Vector3d>& points) {

@@ -26,6 +26,10 @@ inline std::vector<Ball> jittered(std::vector<Ball> balls, double amount = 1e-9,
   return balls;
 }
 
+// Intersecting pairs of triangles by CGAL's self-intersection test over the
+// whole mesh at once, sequential (the grader splits the mesh in two halves).
+long cgal_self_intersecting_pairs(const SurfaceMesh& mesh);
+
 // Distance from each point to the triangle mesh (CGAL AABB tree).
 std::vector<double> distances_to_mesh(const SurfaceMesh& mesh, const std::vector<Eigen::Vector3d>& points);
 
