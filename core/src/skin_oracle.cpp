@@ -118,6 +118,16 @@ struct Solution {
   std::vector<double> lambda;
 };
 
+// A support holds at most 4 balls with affinely independent centres, and one
+// more enters before a step drops one: fixed-capacity matrices spare a heap
+// allocation per matrix per iteration (half the oracle's time went to malloc
+// and free on 3mht's 164,000 vertices).
+constexpr int kMaxSupport = 8;
+using SupportVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSupport + 1, 1>;
+using SupportMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxSupport + 1, kMaxSupport + 1>;
+using CentreMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxSupport>;
+using AffineMatrix = Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxSupport>;
+
 // Active-set solve restricted to `candidates`. Returns the support and weights.
 Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
   const double s = p.s;
@@ -139,40 +149,40 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
     Eigen::Vector3d y = Eigen::Vector3d::Zero();
     for (int a = 0; a < k; ++a) y += l[a] * p.balls[static_cast<size_t>(S[a])].center;
     const Eigen::Vector3d r = p.x - y;
-    Eigen::VectorXd g(k);
+    SupportVector g(k);
     // Centres relative to x: the objective only sees x - Z l, and with
     // coordinates ~100 A the absolute Gram matrix has entries ~1e4 that are
     // nearly equal, which makes the KKT system look singular when it is not.
-    Eigen::MatrixXd Z(3, k);
+    CentreMatrix Z(3, k);
     for (int a = 0; a < k; ++a) {
       g[a] = p.gradient_entry(S[a], r);
       Z.col(a) = p.balls[static_cast<size_t>(S[a])].center - p.x;
     }
     // The KKT system below is singular exactly when the centres of S are
     // affinely dependent: [Z; 1^T] d = 0 has a non-zero solution.
-    Eigen::MatrixXd A(4, k);
+    AffineMatrix A(4, k);
     A.topRows(3) = Z;
     A.row(3).setOnes();
-    Eigen::FullPivLU<Eigen::MatrixXd> dependence(A);
+    Eigen::FullPivLU<AffineMatrix> dependence(A);
     dependence.setThreshold(1e-10);
     const bool singular = dependence.rank() < k;
-    Eigen::VectorXd step;
+    SupportVector step;
     double mu = 0;
     if (!singular) {
       // Equality-constrained step on S: [2(1-s) Z^T Z, -1; 1^T, 0] [step; mu] = [-g; 0].
-      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(k + 1, k + 1);
+      SupportMatrix M = SupportMatrix::Zero(k + 1, k + 1);
       M.topLeftCorner(k, k) = 2 * (1 - s) * Z.transpose() * Z;
       M.block(0, k, k, 1).setConstant(-1.0);
       M.block(k, 0, 1, k).setConstant(1.0);
-      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(k + 1);
+      SupportVector rhs = SupportVector::Zero(k + 1);
       rhs.head(k) = -g;
-      const Eigen::VectorXd sol = M.fullPivLu().solve(rhs);
+      const SupportVector sol = M.fullPivLu().solve(rhs);
       step = sol.head(k);
       mu = sol[k];
     } else {
       // Affinely dependent centres: along a direction d with sum d = 0 and
       // Z d = 0 the objective is linear; go downhill until a weight reaches 0.
-      Eigen::VectorXd d = dependence.kernel().col(0);
+      SupportVector d = dependence.kernel().col(0);
       if (g.dot(d) > 0) d = -d;
       step = d * 1e30;  // unbounded along d: the ratio test below stops it
     }
@@ -187,7 +197,9 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
         const double multiplier = p.gradient_entry(i, r) - mu;
         if (multiplier < most_negative) most_negative = multiplier, entering = i;
       }
-      if (entering < 0) return {S, l};
+      // (A support at capacity cannot happen, see kMaxSupport; were it to,
+      // the caller's KKT check against every ball would leave x uncertified.)
+      if (entering < 0 || k == kMaxSupport) return {S, l};
       S.push_back(entering);
       l.push_back(0.0);
       continue;
@@ -312,10 +324,14 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
     near.resize(static_cast<size_t>(n));
     std::iota(near.begin(), near.end(), 0);
   }
-  std::vector<double> near_power(near.size());
-  for (size_t a = 0; a < near.size(); ++a) near_power[a] = balls_[static_cast<size_t>(near[a])].power(x);
+  // The 24 of least power, selected on (power, ball) pairs in one array.
+  std::vector<std::pair<double, int>> by_power(near.size());
+  for (size_t a = 0; a < near.size(); ++a) by_power[a] = {balls_[static_cast<size_t>(near[a])].power(x), near[a]};
+  const size_t count = std::min<size_t>(24, by_power.size());
+  std::nth_element(by_power.begin(), by_power.begin() + static_cast<long>(count - 1), by_power.end());
   std::vector<int> candidates;
-  for (int a : smallest(near_power, 24)) candidates.push_back(near[static_cast<size_t>(a)]);
+  candidates.reserve(count + 8);
+  for (size_t a = 0; a < count; ++a) candidates.push_back(by_power[a].second);
   OracleResult out;
   for (int round = 0; round < 50; ++round) {
     const Solution sol = solve_on(p, candidates);
