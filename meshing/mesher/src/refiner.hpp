@@ -250,7 +250,7 @@ class Refiner {
   // 1,024 a side around the molecule; beyond, the outermost).
   uint32_t tile_of(const Eigen::Vector3d& p) const;
   std::optional<Vertex_handle> refine_one(FacetEval e, unsigned refine_start, std::vector<FacetEval>* requeue);
-  std::vector<Facet> batch_facets(const std::vector<Vertex_handle>& batch, unsigned since) const;
+  std::vector<Facet> made_facets() const;
   // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.
   void keep_restricted(const std::vector<Facet>& facets, FacetEvals* restricted) const;
   bool global_pass();
@@ -291,6 +291,9 @@ class Refiner {
   bool still_stands(const BatchFound& f) const;
   void keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals);
   std::vector<Cell_handle> star_;    // cells made by the last insertion
+  // Cells made by insert() since made_since_ (a refinement batch), with their stamps.
+  std::vector<std::pair<Cell_handle, unsigned>> made_;
+  unsigned made_since_ = 0;
   std::vector<Vertex_handle> recent_;  // inserted since the last global or local pass
   unsigned stamp_ = 0;
   // The restricted facets of the last global pass in the order of their keys,
