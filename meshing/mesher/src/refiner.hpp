@@ -250,7 +250,7 @@ class Refiner {
   // 1,024 a side around the molecule; beyond, the outermost).
   uint32_t tile_of(const Eigen::Vector3d& p) const;
   std::optional<Vertex_handle> refine_one(FacetEval e, unsigned refine_start, std::vector<FacetEval>* requeue);
-  std::vector<Facet> made_facets() const;
+  void made_facets(std::vector<Facet>* facets) const;  // replaces *facets
   // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.
   void keep_restricted(const std::vector<Facet>& facets, FacetEvals* restricted) const;
   bool global_pass();

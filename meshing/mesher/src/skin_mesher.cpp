@@ -274,9 +274,9 @@ void Refiner::keep_restricted(const std::vector<Facet>& facets, FacetEvals* rest
 // each once: a facet between two such cells is listed from the one made
 // first. (Listing the cells around the new vertices again, as CGAL finds
 // them, cost 0.4 s of 3mht's refinement; insert() has them already.)
-std::vector<Facet> Refiner::made_facets() const {
-  std::vector<Facet> out;
-  out.reserve(made_.size() * 2);
+void Refiner::made_facets(std::vector<Facet>* facets) const {
+  std::vector<Facet>& out = *facets;
+  out.clear();
   for (const auto& [c, stamp] : made_) {
     // A cell made and then replaced within the batch is gone (or its place
     // holds a newer cell, with another stamp).
@@ -289,7 +289,6 @@ std::vector<Facet> Refiner::made_facets() const {
       out.emplace_back(c, j);
     }
   }
-  return out;
 }
 
 // One queued bad facet: its surface ball centre inserted (the new vertex is
@@ -393,7 +392,10 @@ void Refiner::refine() {
   constexpr size_t kBatch = 256;
   std::vector<Vertex_handle> batch;
   std::vector<FacetEval> requeue;
-  std::vector<FacetShape> shapes;
+  // Kept across batches: each is hundreds of kilobytes, which the allocator
+  // maps afresh (allocator.hpp) and the kernel then zeroes page by page.
+  std::vector<Facet> facets;
+  std::vector<FacetShape> shapes, next;
   std::vector<FacetEval> evals;
   tbb::task_group evaluating;
   bool in_flight = false;
@@ -420,14 +422,13 @@ void Refiner::refine() {
       if (const std::optional<Vertex_handle> v = refine_one(e, refine_start, &requeue)) batch.push_back(*v);
       for (const FacetEval& r : requeue) push(r);
     }
-    const std::vector<Facet> facets = made_facets();
-    std::vector<FacetShape> next;
-    next.reserve(facets.size());
+    made_facets(&facets);
+    next.clear();
     for (const Facet& f : facets)
       if (roles_.empty() || active(facet_key(f))) next.push_back(shape_of(f));
     if (in_flight) collect();
-    shapes = std::move(next);
-    evals.assign(shapes.size(), FacetEval{});
+    shapes.swap(next);
+    evals.resize(shapes.size());
     evaluating.run([this, &shapes, &evals] {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, shapes.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k != r.end(); ++k) evals[k] = evaluate(shapes[k]);
