@@ -291,9 +291,11 @@ class Refiner {
   bool still_stands(const BatchFound& f) const;
   void keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals);
   std::vector<Cell_handle> star_;    // cells made by the last insertion
-  // Cells made by insert() since made_since_ (a refinement batch), with their stamps.
+  // Cells made by insert() since made_since_ (a refinement batch), with
+  // their stamps; recorded only while refine() runs (seeding made 8 MB of them).
   std::vector<std::pair<Cell_handle, unsigned>> made_;
   unsigned made_since_ = 0;
+  bool recording_made_ = false;
   std::vector<Vertex_handle> recent_;  // inserted since the last global or local pass
   unsigned stamp_ = 0;
   // The restricted facets of the last global pass in the order of their keys,

@@ -176,7 +176,7 @@ Vertex_handle Refiner::insert(const Eigen::Vector3d& point, int cell, Cell_handl
     dt_.incident_cells(v, std::back_inserter(star_));
     for (const Cell_handle& c : star_) {
       c->info().value = ++stamp_;
-      made_.emplace_back(c, stamp_);
+      if (recording_made_) made_.emplace_back(c, stamp_);
     }
     recent_.push_back(v);
   }
@@ -406,6 +406,7 @@ void Refiner::refine() {
       if (e.crossings > 0 && e.defect != TriangleDefect::none) push(e);
     keep_batch_found(shapes, evals);
   };
+  recording_made_ = true;
   while (!heap.empty() || in_flight) {
     if (heap.empty()) {
       collect();
@@ -438,6 +439,8 @@ void Refiner::refine() {
     check_budget();
     report("refining", Report::throttled, static_cast<long>(heap.size()));
   }
+  recording_made_ = false;
+  made_.clear();
   if (stamp_ > refine_start) batch_stamps_.emplace_back(refine_start, stamp_);
 }
 
