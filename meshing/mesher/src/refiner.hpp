@@ -243,6 +243,7 @@ class Refiner {
   void insert_seeds(double spacing);
   void insert_samples(const std::vector<SkinSample>& samples);
   Vertex_handle insert(const Eigen::Vector3d& p, int cell, Cell_handle hint);
+  void stamp_star(Vertex_handle v);  // stamps the cells around a new vertex, into star_
   void push_if_bad(const FacetEval& e);
   void push_repair(FacetEval e);  // a vertex-star repair: insert its ball centre even without a defect
   void refine();
