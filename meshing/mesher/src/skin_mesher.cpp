@@ -543,24 +543,45 @@ bool Refiner::global_pass() {
   facets.reserve(kChunk);
   std::vector<uint32_t> unchanged;  // positions in restricted_
   FacetEvals fresh;
-  for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) {
-    if (!roles_.empty() && !active(facet_key(*f))) continue;
-    if (have_pass_cache_) {
-      const Cell_handle c = f->first, n = c->neighbor(f->second);
-      const unsigned sc = c->info().value, sn = n->info().value;
-      if (sc <= last_pass_stamp_ && sn <= last_pass_stamp_) {
-        if (const std::optional<uint32_t> k = find_restricted(facet_key(*f))) unchanged.push_back(*k);
-        continue;
+  // What the pass does with a facet (sorted in parallel, a chunk of the
+  // triangulation's facets at a time, then taken in order): a position in
+  // restricted_ (unchanged and restricted), or one of these.
+  constexpr int64_t kSkip = -1, kEvaluate = -2;
+  auto classify = [&](const Facet& f) -> int64_t {
+    if (!roles_.empty() && !active(facet_key(f))) return kSkip;
+    if (!have_pass_cache_) return kEvaluate;
+    const Cell_handle c = f.first, n = c->neighbor(f.second);
+    const unsigned sc = c->info().value, sn = n->info().value;
+    if (sc <= last_pass_stamp_ && sn <= last_pass_stamp_) {
+      const std::optional<uint32_t> k = find_restricted(facet_key(f));
+      return k ? static_cast<int64_t>(*k) : kSkip;
+    }
+    // Evaluated by the batch that made its newer cell: in batch_found_ if restricted.
+    return made_by_batch(std::max(sc, sn)) ? kSkip : kEvaluate;
+  };
+  std::vector<Facet> scanned;
+  std::vector<int64_t> verdict;
+  auto take_scanned = [&] {
+    verdict.resize(scanned.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, scanned.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t k = r.begin(); k != r.end(); ++k) verdict[k] = classify(scanned[k]);
+    });
+    for (size_t k = 0; k < scanned.size(); ++k) {
+      if (verdict[k] >= 0) unchanged.push_back(static_cast<uint32_t>(verdict[k]));
+      if (verdict[k] != kEvaluate) continue;
+      facets.push_back(scanned[k]);
+      if (facets.size() == kChunk) {
+        keep_restricted(facets, &fresh);
+        facets.clear();
       }
-      // Evaluated by the batch that made its newer cell: in batch_found_ if restricted.
-      if (made_by_batch(std::max(sc, sn))) continue;
     }
-    facets.push_back(*f);
-    if (facets.size() == kChunk) {
-      keep_restricted(facets, &fresh);
-      facets.clear();
-    }
+    scanned.clear();
+  };
+  for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) {
+    scanned.push_back(*f);
+    if (scanned.size() == 4 * kChunk) take_scanned();
   }
+  take_scanned();
   for (; !batch_found_.empty(); batch_found_.pop_front()) {
     if (!still_stands(batch_found_.front())) continue;
     facets.emplace_back(batch_found_.front().cell, batch_found_.front().index);
