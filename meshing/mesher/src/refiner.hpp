@@ -67,6 +67,7 @@ struct FacetEval {
   uint32_t tile = 0;                 // refinement tile of the centre (Refiner::tile_of): the queue's first key
   TriangleDefect defect = TriangleDefect::none;
   bool force = false;                // a vertex-star repair: insert even without a defect
+  bool well_conditioned = false;     // DualEdge::well_conditioned (refine_one skips its nearest-vertex check)
   // The skin's outward side is along +(v1 - v0) x (v2 - v0): the Voronoi edge
   // leaves the skin's inside there (dual_edge walks it along that normal).
   bool outward_along_normal = true;
@@ -84,6 +85,10 @@ struct DualEdge {
   Eigen::Vector3d a, b;
   Eigen::Vector3d apex_c;
   std::optional<Eigen::Vector3d> apex_n;
+  // Both tetrahedra far from flat (each apex at least 1e-3 circumradii off
+  // the triangle's plane): both ends are accurate, and the edge lies within
+  // the true Voronoi edge to rounding.
+  bool well_conditioned = false;
 };
 
 // What an evaluation needs of a facet, taken out of the triangulation so

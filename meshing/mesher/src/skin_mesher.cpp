@@ -53,6 +53,9 @@ std::optional<DualEdge> Refiner::dual_edge(const FacetShape& shape, const Eigen:
                                       : (normal.dot(edge.apex_c - circumcenter) > 0 ? -reach : reach);
   edge.a = circumcenter + std::min(lambda_c, lambda_n) * normal;
   edge.b = circumcenter + std::max(lambda_c, lambda_n) * normal;
+  const double flat = 1e-3 * std::sqrt(circumradius2);
+  edge.well_conditioned = edge.apex_n && std::abs(normal.dot(edge.apex_c - circumcenter)) > flat &&
+                          std::abs(normal.dot(*edge.apex_n - circumcenter)) > flat;
   return edge;
 }
 
@@ -120,6 +123,7 @@ FacetEval Refiner::evaluate(const FacetShape& shape) const {
   e.tile = tile_of(e.center);
   e.cell = hits[best].cell;
   e.radius = std::sqrt(best_r2);
+  e.well_conditioned = edge->well_conditioned;
   e.outward_along_normal = !hits[best].entering;
   RestrictedTriangle triangle;
   triangle.corners = {p0, p1, p2};
@@ -338,15 +342,23 @@ std::optional<Vertex_handle> Refiner::refine_one(FacetEval e, unsigned refine_st
     return std::nullopt;
   }
   if (e.radius < 1e-9) return std::nullopt;  // cannot happen for a proper triangle; never insert a duplicate
-  // The surface Delaunay ball is empty in exact arithmetic. Near a Voronoi
-  // vertex on the skin two Voronoi edges cross it at almost the same point;
-  // after one is inserted the other must not be (a near-duplicate vertex
-  // would send refinement chasing it).
-  const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
-  if ((to_eigen(nearest->point()) - e.center).norm() < 0.5 * e.radius) return std::nullopt;
-  // A patch grows no further than its context: a point nearest a context
-  // vertex would mesh skin the rest of the mesh covers already.
-  if (!active(nearest->info().id)) return std::nullopt;
+  // The surface Delaunay ball is empty in exact arithmetic: a ball centred
+  // on the Voronoi edge through the triangle's vertices lies in the union of
+  // its two tetrahedra's circumballs, which hold no vertex. Where a
+  // tetrahedron is nearly flat its end of the edge is ill-conditioned, and
+  // near a Voronoi vertex on the skin two Voronoi edges cross it at almost
+  // the same point; after one is inserted the other must not be (a
+  // near-duplicate vertex would send refinement chasing it). So the nearest
+  // vertex is looked up there, and in a patch (below); elsewhere the lookup
+  // (CGAL's walk over adjacent vertices, 6% of the main thread on 3mht)
+  // never found one closer than half the radius on the shipped molecules.
+  if (!e.well_conditioned || !roles_.empty()) {
+    const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
+    if ((to_eigen(nearest->point()) - e.center).norm() < 0.5 * e.radius) return std::nullopt;
+    // A patch grows no further than its context: a point nearest a context
+    // vertex would mesh skin the rest of the mesh covers already.
+    if (!active(nearest->info().id)) return std::nullopt;
+  }
   switch (e.defect) {
     case TriangleDefect::topology: ++stats_.inserted_topology; break;
     case TriangleDefect::size: ++stats_.inserted_size; break;
