@@ -312,21 +312,23 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
   }
   const Problem p{balls_, shrink_, x};
   const int n = static_cast<int>(balls_.size());
-  // Candidates: the balls of smallest power distance among those near x.
-  std::vector<int> near;
+  // Candidates: the balls of smallest power distance among those near x,
+  // as (power, ball) pairs in one array, reused by the thread (the oracle
+  // runs on every vertex of a mesh: an allocation per call showed).
+  thread_local std::vector<std::pair<double, int>> buffer;
+  std::vector<std::pair<double, int>>& by_power = buffer;  // one look-up of the thread's copy, not one per use
+  by_power.clear();
   double radius = std::sqrt(std::max(grid_->max_weight(), 0.0)) + 1.0;
   bool all = false;
-  for (int doubling = 0; doubling < 64 && near.size() < 24 && !all; ++doubling, radius *= 2) {
-    near.clear();
-    all = !grid_->within(x, radius, [&](int k) { near.push_back(k); });
+  for (int growth = 0; growth < 128 && by_power.size() < 24 && !all; ++growth, radius *= 2) {
+    by_power.clear();
+    all = !grid_->within(x, radius, [&](int k) { by_power.emplace_back(balls_[static_cast<size_t>(k)].power(x), k); });
   }
-  if (all || near.empty()) {  // most of the grid, or x not a finite point
-    near.resize(static_cast<size_t>(n));
-    std::iota(near.begin(), near.end(), 0);
+  if (all || by_power.empty()) {  // most of the grid, or x not a finite point
+    by_power.resize(static_cast<size_t>(n));
+    for (int k = 0; k < n; ++k) by_power[static_cast<size_t>(k)] = {balls_[static_cast<size_t>(k)].power(x), k};
   }
-  // The 24 of least power, selected on (power, ball) pairs in one array.
-  std::vector<std::pair<double, int>> by_power(near.size());
-  for (size_t a = 0; a < near.size(); ++a) by_power[a] = {balls_[static_cast<size_t>(near[a])].power(x), near[a]};
+  // The 24 of least power.
   const size_t count = std::min<size_t>(24, by_power.size());
   std::nth_element(by_power.begin(), by_power.begin() + static_cast<long>(count - 1), by_power.end());
   std::vector<int> candidates;
