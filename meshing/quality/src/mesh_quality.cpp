@@ -4,6 +4,7 @@
 #include "union_find.hpp"
 
 #include <Eigen/Geometry>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -181,10 +182,19 @@ SurfaceComponents surface_components(const SurfaceMesh& mesh) {
 
 MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
   MeshQuality q;
-  grade_triangles(mesh, q);
-  grade_edges(mesh, q);
-  grade_vertices(mesh, q);
-  const SurfaceComponents components = surface_components(mesh);
+  // The parts write different fields of q and run side by side. The exact
+  // self-intersection test, the longest, starts with them; its count is
+  // used only if the mesh turns out manifold, oriented and without
+  // degenerate triangles (on other meshes CGAL's mesh cannot be built, and
+  // it returns at once).
+  const bool exact = options.self_intersections == SelfIntersectionCheck::exact;
+  long pairs = -1;
+  SurfaceComponents components;
+  tbb::parallel_invoke([&] { grade_triangles(mesh, q); }, [&] { grade_edges(mesh, q); },
+                       [&] { grade_vertices(mesh, q); }, [&] { components = surface_components(mesh); },
+                       [&] {
+                         if (exact) pairs = count_self_intersections(mesh);
+                       });
   q.components = static_cast<long>(components.enclosed_volume.size());
   q.euler = q.vertices - q.edges + q.triangles;
   q.closed = q.boundary_edges == 0;
@@ -196,9 +206,7 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
     // outward normals everywhere else, it is the surface of a cavity.
     for (int c = 0; c < static_cast<int>(q.components); ++c) q.cavities += components.is_cavity(c);
   }
-  if (options.self_intersections == SelfIntersectionCheck::exact && q.manifold && q.oriented &&
-      q.degenerate_triangles == 0) {
-    const long pairs = count_self_intersections(mesh);
+  if (exact && q.manifold && q.oriented && q.degenerate_triangles == 0) {
     q.self_intersections_checked = pairs >= 0;
     q.self_intersecting_pairs = std::max(0L, pairs);
   }
