@@ -136,13 +136,13 @@ TEST_CASE("self-intersections: the slabs find CGAL's pairs over the whole mesh",
   // between slabs (quantiles of the triangles' x), one tilted through the
   // other, and a copy shifted a little along x, whose triangles cross their
   // twins near every x, so that many crossing pairs straddle a cut. The
-  // grader cuts a slab per 20,000 triangles: two rings of 48,000 make four.
+  // grader cuts two slabs from 180,000 triangles: two rings of 96,000.
   auto add = [](SurfaceMesh& to, const SurfaceMesh& from, const Eigen::Matrix3d& turn, const Eigen::Vector3d& shift) {
     const int base = static_cast<int>(to.vertices.size());
     for (const auto& v : from.vertices) to.vertices.push_back(turn * v + shift);
     for (auto t : from.triangles) to.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   };
-  const SurfaceMesh ring = torus(400, 60, 3.0, 1.0);
+  const SurfaceMesh ring = torus(800, 60, 3.0, 1.0);
   const Eigen::Matrix3d same = Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d tilted = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitX()).toRotationMatrix();
   for (const Eigen::Vector3d& shift : {Eigen::Vector3d(4.0, 0, 0), Eigen::Vector3d(3.0, 0.5, 0.2), Eigen::Vector3d(0.05, 0.02, 0.3)}) {
