@@ -323,23 +323,37 @@ void Refiner::made_facets(std::vector<Facet>* facets) const {
 // dropped when its newer cell was made during this refinement (refine
 // evaluates every facet of the cells it makes, and queued it then if bad), or
 // evaluated again and, if still to do, put in `requeue`.
-std::optional<Vertex_handle> Refiner::refine_one(FacetEval e, unsigned refine_start, std::vector<FacetEval>* requeue) {
+std::optional<Vertex_handle> Refiner::refine_one(QueuedFacet q, unsigned refine_start,
+                                                std::vector<QueuedFacet>* requeue) {
+  FacetEval& e = q.eval;
   Cell_handle c;
-  int i0, i1, i2;
-  if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) return std::nullopt;
-  const int facet_index = 6 - i0 - i1 - i2;
-  const Cell_handle n = c->neighbor(facet_index);
-  const unsigned sc = c->info().value, sn = n->info().value;
-  if (!((sc == e.stamp_c && sn == e.stamp_n) || (sc == e.stamp_n && sn == e.stamp_c))) {
-    const unsigned newer = std::max(sc, sn);
-    if (newer > refine_start && newer != kFreshCell && !e.force) return std::nullopt;
-    const bool force = e.force;
-    e = evaluate(Facet(c, facet_index));  // its Voronoi edge changed: look again
-    if (e.crossings > 0 && (e.defect != TriangleDefect::none || force)) {
-      e.force = force;
-      requeue->push_back(e);
+  int facet_index = 0;
+  const bool known = q.cell != Cell_handle();
+  if (known && dt_.tds().cells().is_used(q.cell) && q.cell->info().value == e.stamp_c &&
+      q.cell->neighbor(q.index)->info().value == e.stamp_n) {
+    c = q.cell;  // both cells as evaluated (a live cell keeps its vertices)
+    facet_index = q.index;
+  } else {
+    // Evaluated during this refinement and changed since: by this
+    // refinement, which evaluates every cell it makes.
+    if (known && std::max(e.stamp_c, e.stamp_n) > refine_start && !e.force) return std::nullopt;
+    int i0, i1, i2;
+    if (!dt_.tds().is_facet(e.v[0], e.v[1], e.v[2], c, i0, i1, i2)) return std::nullopt;
+    facet_index = 6 - i0 - i1 - i2;
+    const Cell_handle n = c->neighbor(facet_index);
+    const unsigned sc = c->info().value, sn = n->info().value;
+    if (!((sc == e.stamp_c && sn == e.stamp_n) || (sc == e.stamp_n && sn == e.stamp_c))) {
+      const unsigned newer = std::max(sc, sn);
+      if (newer > refine_start && newer != kFreshCell && !e.force) return std::nullopt;
+      const bool force = e.force;
+      const FacetShape shape = shape_of(Facet(c, facet_index));
+      e = evaluate(shape);  // its Voronoi edge changed: look again
+      if (e.crossings > 0 && (e.defect != TriangleDefect::none || force)) {
+        e.force = force;
+        requeue->push_back({e, shape.cell, shape.index});
+      }
+      return std::nullopt;
     }
-    return std::nullopt;
   }
   if (e.radius < 1e-9) return std::nullopt;  // cannot happen for a proper triangle; never insert a duplicate
   // The surface Delaunay ball is empty in exact arithmetic: a ball centred
@@ -405,15 +419,18 @@ void Refiner::refine() {
   // size, 1.3 times tile by tile). Ties broken by the facet's vertex ids: CGAL's containers are
   // ordered by memory addresses in places, and the order of refinement must
   // not be.
-  auto smaller = [](const FacetEval& a, const FacetEval& b) {
+  auto smaller = [](const QueuedFacet& x, const QueuedFacet& y) {
+    const FacetEval &a = x.eval, &b = y.eval;
     if (a.tile != b.tile) return a.tile > b.tile;
     return a.radius < b.radius || (a.radius == b.radius && facet_key(a) > facet_key(b));
   };
-  std::vector<FacetEval> heap = std::move(pending_);
+  std::vector<QueuedFacet> heap;
+  heap.reserve(pending_.size());
+  for (const FacetEval& e : pending_) heap.push_back({e, Cell_handle(), 0});
   pending_.clear();
   std::make_heap(heap.begin(), heap.end(), smaller);
-  auto push = [&](const FacetEval& e) {
-    heap.push_back(e);
+  auto push = [&](const QueuedFacet& q) {
+    heap.push_back(q);
     std::push_heap(heap.begin(), heap.end(), smaller);
   };
   const unsigned refine_start = stamp_;
@@ -429,7 +446,7 @@ void Refiner::refine() {
   // 1,024 3.41-3.45 s, 2,048 3.43 s, 4,096 3.59-3.60 s).
   constexpr size_t kBatch = 1024;
   std::vector<Vertex_handle> batch;
-  std::vector<FacetEval> requeue;
+  std::vector<QueuedFacet> requeue;
   // Kept across batches: each is hundreds of kilobytes, which the allocator
   // maps afresh (allocator.hpp) and the kernel then zeroes page by page.
   std::vector<Facet> facets;
@@ -440,8 +457,9 @@ void Refiner::refine() {
   auto collect = [&] {  // the evaluated batch's bad facets into the queue
     evaluating.wait();
     in_flight = false;
-    for (const FacetEval& e : evals)
-      if (e.crossings > 0 && e.defect != TriangleDefect::none) push(e);
+    for (size_t k = 0; k < evals.size(); ++k)
+      if (evals[k].crossings > 0 && evals[k].defect != TriangleDefect::none)
+        push({evals[k], shapes[k].cell, shapes[k].index});
     keep_batch_found(shapes, evals);
   };
   recording_made_ = true;
@@ -455,11 +473,11 @@ void Refiner::refine() {
     made_since_ = stamp_ + 1;
     while (!heap.empty() && batch.size() < kBatch) {
       std::pop_heap(heap.begin(), heap.end(), smaller);
-      const FacetEval e = heap.back();
+      const QueuedFacet q = heap.back();
       heap.pop_back();
       requeue.clear();
-      if (const std::optional<Vertex_handle> v = refine_one(e, refine_start, &requeue)) batch.push_back(*v);
-      for (const FacetEval& r : requeue) push(r);
+      if (const std::optional<Vertex_handle> v = refine_one(q, refine_start, &requeue)) batch.push_back(*v);
+      for (const QueuedFacet& r : requeue) push(r);
     }
     made_facets(&facets);
     next.clear();
