@@ -266,6 +266,9 @@ class Refiner {
   uint32_t tile_of(const Eigen::Vector3d& p) const;
   std::optional<Vertex_handle> refine_one(QueuedFacet q, unsigned refine_start, std::vector<QueuedFacet>* requeue);
   void made_facets(std::vector<Facet>* facets) const;  // replaces *facets
+  bool made_by_batch(unsigned stamp) const;             // a stamp a batch of refinement made
+  bool still_stands(const BatchFound& f) const;         // both its cells as when found
+  void keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals);
   // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.
   void keep_restricted(const std::vector<Facet>& facets, FacetEvals* restricted) const;
   bool global_pass();
@@ -302,9 +305,6 @@ class Refiner {
   std::vector<std::pair<unsigned, unsigned>> batch_stamps_;
   std::deque<BatchFound> batch_found_;
   size_t batch_found_after_cleanup_ = 0;
-  bool made_by_batch(unsigned stamp) const;
-  bool still_stands(const BatchFound& f) const;
-  void keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals);
   std::vector<Cell_handle> star_;    // cells made by the last insertion
   // Cells made by insert() since made_since_ (a refinement batch), with
   // their stamps; recorded only while refine() runs (seeding made 8 MB of them).
