@@ -267,7 +267,9 @@ class Refiner {
   std::optional<Vertex_handle> refine_one(QueuedFacet q, unsigned refine_start, std::vector<QueuedFacet>* requeue);
   void made_facets(std::vector<Facet>* facets) const;  // replaces *facets
   bool made_by_batch(unsigned stamp) const;             // a stamp a batch of refinement made
-  bool still_stands(const BatchFound& f) const;         // both its cells as when found
+  // Whether facet `index` of c lies between the same two cells as when they
+  // had these stamps (c may have been freed: the container tells).
+  bool still_stands(Cell_handle c, int index, unsigned stamp_c, unsigned stamp_n) const;
   void keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals);
   // Appends the restricted ones of `facets` (evaluated in parallel) to `restricted`.
   void keep_restricted(const std::vector<Facet>& facets, FacetEvals* restricted) const;

@@ -329,8 +329,7 @@ std::optional<Vertex_handle> Refiner::refine_one(QueuedFacet q, unsigned refine_
   Cell_handle c;
   int facet_index = 0;
   const bool known = q.cell != Cell_handle();
-  if (known && dt_.tds().cells().is_used(q.cell) && q.cell->info().value == e.stamp_c &&
-      q.cell->neighbor(q.index)->info().value == e.stamp_n) {
+  if (known && still_stands(q.cell, q.index, e.stamp_c, e.stamp_n)) {
     c = q.cell;  // both cells as evaluated (a live cell keeps its vertices)
     facet_index = q.index;
   } else {
@@ -445,7 +444,6 @@ void Refiner::refine() {
   // replaces are never evaluated (3mht refining: 256 3.60 s, 512 3.49 s,
   // 1,024 3.41-3.45 s, 2,048 3.43 s, 4,096 3.59-3.60 s).
   constexpr size_t kBatch = 1024;
-  std::vector<Vertex_handle> batch;
   std::vector<QueuedFacet> requeue;
   // Kept across batches: each is hundreds of kilobytes, which the allocator
   // maps afresh (allocator.hpp) and the kernel then zeroes page by page.
@@ -468,15 +466,15 @@ void Refiner::refine() {
       collect();
       continue;
     }
-    batch.clear();
+    size_t inserted = 0;
     made_.clear();
     made_since_ = stamp_ + 1;
-    while (!heap.empty() && batch.size() < kBatch) {
+    while (!heap.empty() && inserted < kBatch) {
       std::pop_heap(heap.begin(), heap.end(), smaller);
       const QueuedFacet q = heap.back();
       heap.pop_back();
       requeue.clear();
-      if (const std::optional<Vertex_handle> v = refine_one(q, refine_start, &requeue)) batch.push_back(*v);
+      inserted += refine_one(q, refine_start, &requeue).has_value();
       for (const QueuedFacet& r : requeue) push(r);
     }
     made_facets(&facets);
@@ -510,9 +508,9 @@ bool Refiner::made_by_batch(unsigned stamp) const {
 // Whether the facet is still there between the same two cells. A cell is
 // never changed in place by insertion, and a new cell gets a new stamp (a
 // freed cell's place is recognised by the container without reading it).
-bool Refiner::still_stands(const BatchFound& f) const {
-  if (!dt_.tds().cells().is_used(f.cell) || f.cell->info().value != f.stamp_c) return false;
-  return f.cell->neighbor(f.index)->info().value == f.stamp_n;
+bool Refiner::still_stands(Cell_handle c, int index, unsigned stamp_c, unsigned stamp_n) const {
+  if (!dt_.tds().cells().is_used(c) || c->info().value != stamp_c) return false;
+  return c->neighbor(index)->info().value == stamp_n;
 }
 
 void Refiner::keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals) {
@@ -523,7 +521,7 @@ void Refiner::keep_batch_found(const std::vector<FacetShape>& shapes, const std:
   // the list has grown by half, so that it stays near the live restricted count.
   if (batch_found_.size() < batch_found_after_cleanup_ + batch_found_after_cleanup_ / 2 + 65536) return;
   batch_found_.erase(std::remove_if(batch_found_.begin(), batch_found_.end(),
-                                    [&](const BatchFound& f) { return !still_stands(f); }),
+                                    [&](const BatchFound& f) { return !still_stands(f.cell, f.index, f.stamp_c, f.stamp_n); }),
                      batch_found_.end());
   batch_found_.shrink_to_fit();
   batch_found_after_cleanup_ = batch_found_.size();
@@ -613,7 +611,8 @@ bool Refiner::global_pass() {
   }
   take_scanned();
   for (; !batch_found_.empty(); batch_found_.pop_front()) {
-    if (!still_stands(batch_found_.front())) continue;
+    const BatchFound& f = batch_found_.front();
+    if (!still_stands(f.cell, f.index, f.stamp_c, f.stamp_n)) continue;
     facets.emplace_back(batch_found_.front().cell, batch_found_.front().index);
     if (facets.size() == kChunk) {
       keep_restricted(facets, &fresh);
