@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 using namespace skinmesh;
@@ -154,6 +155,41 @@ TEST_CASE("self-intersections: the slabs find CGAL's pairs over the whole mesh",
     CHECK(count_self_intersections(both) == expected);
   }
   CHECK(count_self_intersections(ring) == 0);
+}
+
+TEST_CASE("self-intersections: folds between neighbours count as CGAL counts them", "[quality]") {
+  // The count decides pairs that share an edge or a vertex on its own (CGAL
+  // decides them by its halfedge mesh): a torus whose vertices are shaken by
+  // about an edge's length folds over in every way, and a flat grid with a
+  // vertex pushed across its neighbours folds in its own plane, the exactly
+  // coplanar case.
+  SurfaceMesh shaken = torus(40, 24, 3.0, 1.0);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> shake(-0.25, 0.25);
+  for (Eigen::Vector3d& v : shaken.vertices) v += Eigen::Vector3d(shake(random), shake(random), shake(random));
+  const long expected_shaken = test::cgal_self_intersecting_pairs(shaken);
+  REQUIRE(expected_shaken > 0);
+  CHECK(count_self_intersections(shaken) == expected_shaken);
+
+  SurfaceMesh flat;
+  const int side = 6;
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j) flat.vertices.emplace_back(i, j, 0.0);
+  for (int i = 0; i + 1 < side; ++i)
+    for (int j = 0; j + 1 < side; ++j) {
+      const int v = i * side + j;
+      flat.triangles.push_back({v, v + side, v + side + 1});
+      flat.triangles.push_back({v, v + side + 1, v + 1});
+    }
+  for (const Eigen::Vector3d& push : {Eigen::Vector3d(1.5, 0, 0), Eigen::Vector3d(0.8, 1.3, 0), Eigen::Vector3d(2.3, 1.6, 0)}) {
+    SurfaceMesh folded = flat;
+    folded.vertices[2 * side + 2] += push;
+    const long expected = test::cgal_self_intersecting_pairs(folded);
+    CAPTURE(push.transpose(), expected);
+    REQUIRE(expected > 0);
+    CHECK(count_self_intersections(folded) == expected);
+  }
+  CHECK(count_self_intersections(flat) == 0);
 }
 
 TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {

@@ -185,8 +185,7 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
   // The parts write different fields of q and run side by side. The exact
   // self-intersection test, the longest, starts with them; its count is
   // used only if the mesh turns out manifold, oriented and without
-  // degenerate triangles (on other meshes CGAL's mesh cannot be built, and
-  // it returns at once).
+  // degenerate triangles (given a degenerate one it returns at once).
   const bool exact = options.self_intersections == SelfIntersectionCheck::exact;
   long pairs = -1;
   SurfaceComponents components;

@@ -1,14 +1,15 @@
-// Exact self-intersection check (CGAL Polygon_mesh_processing, exact
-// predicates); CGAL stays in this file.
+// Exact self-intersection count: CGAL's box intersection finds the pairs of
+// triangles whose bounding boxes meet, and CGAL's exact predicates decide
+// each pair, on the triangles' vertex indices (no halfedge mesh is built:
+// building one was a tenth of the count). CGAL stays in this file.
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Surface_mesh.h>
+#include <CGAL/box_intersection_d.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <iterator>
+#include <array>
 #include <utility>
 #include <vector>
 
@@ -17,46 +18,71 @@ namespace skinmesh {
 namespace {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Mesh = CGAL::Surface_mesh<K::Point_3>;
-using FacePair = std::pair<Mesh::Face_index, Mesh::Face_index>;
+using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int, CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
 
-// The triangles' extent along x: [low, high] of each.
-std::vector<std::pair<double, double>> x_extents(const SurfaceMesh& mesh) {
-  std::vector<std::pair<double, double>> out;
-  out.reserve(mesh.triangles.size());
-  for (const auto& t : mesh.triangles) {
-    const double a = mesh.vertices[t[0]].x(), b = mesh.vertices[t[1]].x(), c = mesh.vertices[t[2]].x();
-    out.emplace_back(std::min({a, b, c}), std::max({a, b, c}));
-  }
-  return out;
+K::Point_3 point(const SurfaceMesh& mesh, int v) {
+  const Eigen::Vector3d& p = mesh.vertices[static_cast<size_t>(v)];
+  return {p.x(), p.y(), p.z()};
 }
 
-}  // namespace
+bool degenerate(const SurfaceMesh& mesh, const std::array<int, 3>& t) {
+  return t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
+         CGAL::collinear(point(mesh, t[0]), point(mesh, t[1]), point(mesh, t[2]));
+}
 
-// CGAL's own parallel mode shuffles the boxes and was slower here (1hpv's
-// grading 0.41 to 0.56 s). Instead the triangles are cut at quantiles of
-// their x extents into slabs, each checked by CGAL's sequential test as a
-// task of its own (beside the oracle's, so the cores share them). A triangle
-// goes to every slab its x extent meets, so every pair whose boxes meet lies
-// wholly in a slab (the slab holding an x both extents reach); pairs found in
-// two slabs are counted once.
-long count_self_intersections(const SurfaceMesh& mesh) {
-  Mesh sm;
-  sm.reserve(static_cast<Mesh::size_type>(mesh.vertices.size()), static_cast<Mesh::size_type>(mesh.triangles.size() * 3 / 2),
-             static_cast<Mesh::size_type>(mesh.triangles.size()));
-  std::vector<Mesh::Vertex_index> handle;
-  handle.reserve(mesh.vertices.size());
-  for (const Eigen::Vector3d& p : mesh.vertices) handle.push_back(sm.add_vertex(K::Point_3(p.x(), p.y(), p.z())));
-  for (const auto& t : mesh.triangles)
-    if (sm.add_face(handle[t[0]], handle[t[1]], handle[t[2]]) == Mesh::null_face()) return -1;
-  const std::vector<std::pair<double, double>> extent = x_extents(mesh);
-  // Two slabs from 180,000 triangles, else one: each slab costs CGAL's test
-  // more than its share (grading 1hpv beside the oracle: 8 slabs of 20,000
-  // 0.323 s, 4 of 45,000 0.304 s, 2 0.297 s; 1ubi whole 0.098 s, in 3 slabs 0.102 s).
-  const size_t slabs = std::clamp<size_t>(extent.size() / 90000, 1, 2);
+// Whether two non-degenerate triangles meet in more than the vertices and
+// edge they share (by index). Sharing an edge uv with far corners p and q:
+// only when p, u, v, q are coplanar and p, q lie on the same side of uv.
+// Sharing a vertex w: the two meet along the line through w common to both
+// planes (or in their common plane), and beyond w exactly when the edge
+// opposite w of one triangle meets the other triangle. Sharing nothing: when
+// they meet at all. All three sets of vertices the same: they coincide.
+bool triangles_cross(const SurfaceMesh& mesh, const std::array<int, 3>& a, const std::array<int, 3>& b) {
+  int shared = 0, ia = -1, ib = -1;  // a[ia] == b[ib] for the last shared pair
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (a[i] == b[j]) ++shared, ia = i, ib = j;
+  const auto p = [&](const std::array<int, 3>& t, int i) { return point(mesh, t[static_cast<size_t>(i % 3)]); };
+  if (shared == 3) return true;
+  if (shared == 2) {
+    // The corner of a not in b, and of b not in a; u, v the shared corners.
+    int far_a = 0, far_b = 0;
+    while (std::find(b.begin(), b.end(), a[static_cast<size_t>(far_a)]) != b.end()) ++far_a;
+    while (std::find(a.begin(), a.end(), b[static_cast<size_t>(far_b)]) != a.end()) ++far_b;
+    const K::Point_3 u = p(a, far_a + 1), v = p(a, far_a + 2), pa = p(a, far_a), pb = p(b, far_b);
+    return CGAL::coplanar(u, v, pa, pb) && CGAL::coplanar_orientation(u, v, pa, pb) == CGAL::POSITIVE;
+  }
+  const K::Triangle_3 ta(p(a, 0), p(a, 1), p(a, 2)), tb(p(b, 0), p(b, 1), p(b, 2));
+  if (shared == 0) return CGAL::do_intersect(ta, tb);
+  const K::Segment_3 opposite_a(p(a, ia + 1), p(a, ia + 2)), opposite_b(p(b, ib + 1), p(b, ib + 2));
+  // A triangle whose opposite edge lies strictly on one side of the other's
+  // plane touches that plane only at w: the usual case on a smooth surface,
+  // decided by two orientations instead of two triangle-segment tests.
+  const auto off_plane = [](const K::Triangle_3& t, const K::Segment_3& s) {
+    const CGAL::Orientation o = CGAL::orientation(t[0], t[1], t[2], s.source());
+    return o != CGAL::COPLANAR && o == CGAL::orientation(t[0], t[1], t[2], s.target());
+  };
+  if (off_plane(tb, opposite_a) || off_plane(ta, opposite_b)) return false;
+  return CGAL::do_intersect(ta, opposite_b) || CGAL::do_intersect(tb, opposite_a);
+}
+
+Box box_of(const SurfaceMesh& mesh, int f) {
+  const auto& t = mesh.triangles[static_cast<size_t>(f)];
+  const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
+  const Eigen::Vector3d& b = mesh.vertices[static_cast<size_t>(t[1])];
+  const Eigen::Vector3d& c = mesh.vertices[static_cast<size_t>(t[2])];
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = std::min({a[k], b[k], c[k]}), hi[k] = std::max({a[k], b[k], c[k]});
+  return Box(lo, hi, f);
+}
+
+// The triangles cut into `slabs` ranges of x at quantiles of their boxes'
+// middles; a triangle goes to every slab its x extent meets, so every pair
+// whose boxes meet lies wholly in a slab (the one holding an x both reach).
+std::vector<std::vector<const Box*>> cut_into_slabs(const std::vector<Box>& boxes, size_t slabs) {
   std::vector<double> middle;
-  middle.reserve(extent.size());
-  for (const auto& e : extent) middle.push_back(0.5 * (e.first + e.second));
+  middle.reserve(boxes.size());
+  for (const Box& b : boxes) middle.push_back(0.5 * (b.min_coord(0) + b.max_coord(0)));
   std::vector<double> cut;  // slab k is [cut[k-1], cut[k]], the outer ones open
   for (size_t k = 1; k < slabs; ++k) {
     auto at = middle.begin() + static_cast<long>(middle.size() * k / slabs);
@@ -64,23 +90,49 @@ long count_self_intersections(const SurfaceMesh& mesh) {
     cut.push_back(*at);
   }
   std::sort(cut.begin(), cut.end());
-  std::vector<std::vector<Mesh::Face_index>> slab(slabs);
-  for (size_t f = 0; f < extent.size(); ++f) {
-    const Mesh::Face_index face(static_cast<Mesh::size_type>(f));  // faces were added in order
-    // Slabs from the first whose upper cut reaches the extent's low end to
-    // the last whose lower cut the high end reaches.
-    const size_t first = static_cast<size_t>(std::lower_bound(cut.begin(), cut.end(), extent[f].first) - cut.begin());
-    const size_t last = static_cast<size_t>(std::upper_bound(cut.begin(), cut.end(), extent[f].second) - cut.begin());
-    for (size_t k = first; k <= std::min(last, slabs - 1); ++k) slab[k].push_back(face);
+  std::vector<std::vector<const Box*>> slab(slabs);
+  for (const Box& b : boxes) {
+    const size_t first = static_cast<size_t>(std::lower_bound(cut.begin(), cut.end(), b.min_coord(0)) - cut.begin());
+    const size_t last = static_cast<size_t>(std::upper_bound(cut.begin(), cut.end(), b.max_coord(0)) - cut.begin());
+    for (size_t k = first; k <= std::min(last, slabs - 1); ++k) slab[k].push_back(&b);
   }
-  std::vector<std::vector<FacePair>> found(slabs);
+  return slab;
+}
+
+}  // namespace
+
+// CGAL's own parallel mode shuffles the boxes and was slower here (1hpv's
+// grading 0.41 to 0.56 s). Instead the slabs are checked each as a task of
+// its own (beside the oracle's, so the cores share them); pairs found in two
+// slabs are counted once.
+long count_self_intersections(const SurfaceMesh& mesh) {
+  for (const auto& t : mesh.triangles)
+    if (degenerate(mesh, t)) return -1;
+  std::vector<Box> boxes;
+  boxes.reserve(mesh.triangles.size());
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) boxes.push_back(box_of(mesh, static_cast<int>(f)));
+  // Two slabs from 180,000 triangles, else one: each slab costs the box
+  // intersection more than its share (grading 1hpv beside the oracle: 8
+  // slabs of 20,000 0.323 s, 4 of 45,000 0.304 s, 2 0.297 s; 1ubi whole
+  // 0.098 s, in 3 slabs 0.102 s).
+  const size_t slabs = std::clamp<size_t>(boxes.size() / 90000, 1, 2);
+  std::vector<std::vector<const Box*>> slab = cut_into_slabs(boxes, slabs);
+  std::vector<std::vector<std::pair<int, int>>> found(slabs);
   tbb::parallel_for(size_t{0}, slabs, [&](size_t k) {
-    CGAL::Polygon_mesh_processing::self_intersections(slab[k], sm, std::back_inserter(found[k]));
+    // CGAL's cutoff below which a range is scanned instead of split: 2,000,
+    // as CGAL's own self-intersection test uses (boxes of 1ubi's mesh: 35 ms
+    // at 2,000, 47 ms at 300, 93 ms at 10).
+    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(
+        slab[k].begin(), slab[k].end(),
+        [&](const Box* x, const Box* y) {
+          const auto& a = mesh.triangles[static_cast<size_t>(x->info())];
+          const auto& b = mesh.triangles[static_cast<size_t>(y->info())];
+          if (triangles_cross(mesh, a, b)) found[k].emplace_back(std::minmax(x->info(), y->info()));
+        },
+        std::ptrdiff_t{2000});
   });
-  std::vector<FacePair> pairs;
+  std::vector<std::pair<int, int>> pairs;
   for (const auto& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
-  for (FacePair& p : pairs)
-    if (p.second < p.first) std::swap(p.first, p.second);
   std::sort(pairs.begin(), pairs.end());
   return static_cast<long>(std::unique(pairs.begin(), pairs.end()) - pairs.begin());
 }

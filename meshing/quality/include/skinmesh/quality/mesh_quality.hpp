@@ -41,7 +41,7 @@ struct MeshQuality {
   Histogram min_angle_histogram;             // 0-60 degrees, 12 bins
 };
 
-enum class SelfIntersectionCheck { exact, skip };  // exact: CGAL, O(n log n) with box intersection
+enum class SelfIntersectionCheck { exact, skip };  // exact: CGAL's predicates, O(n log n) with box intersection
 
 struct GradeOptions {
   SelfIntersectionCheck self_intersections = SelfIntersectionCheck::exact;
@@ -49,9 +49,10 @@ struct GradeOptions {
 
 MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options = {});
 
-// Exact self-intersection check of a manifold mesh (CGAL Polygon_mesh_processing):
-// the number of intersecting triangle pairs, or -1 when the mesh cannot be
-// built as a manifold surface.
+// Exact self-intersection check (CGAL's box intersection and exact
+// predicates): the number of triangle pairs that meet in more than the
+// vertices and edge they share by index, or -1 when a triangle is degenerate
+// (two equal indices or collinear corners), where the question has no answer.
 long count_self_intersections(const SurfaceMesh& mesh);
 
 // The connected components of a mesh's triangles (through shared vertices)
