@@ -269,23 +269,6 @@ void take_solution(Result& out, const Stationary& st, const Solution& sol, Name 
     if (sol.lambda[a] > 0) out.support.emplace_back(name(sol.support[a]), sol.lambda[a]);
 }
 
-// The indices of the `count` smallest values.
-std::vector<int> smallest(const std::vector<double>& values, int count) {
-  std::vector<int> order(values.size());
-  std::iota(order.begin(), order.end(), 0);
-  count = std::min(count, static_cast<int>(values.size()));
-  std::nth_element(order.begin(), order.begin() + (count - 1), order.end(),
-                   [&](int a, int b) { return values[static_cast<size_t>(a)] < values[static_cast<size_t>(b)]; });
-  order.resize(static_cast<size_t>(count));
-  return order;
-}
-
-std::vector<double> powers(const std::vector<Ball>& balls, const Eigen::Vector3d& x) {
-  std::vector<double> out(balls.size());
-  for (size_t i = 0; i < balls.size(); ++i) out[i] = balls[i].power(x);
-  return out;
-}
-
 }  // namespace
 
 namespace {
@@ -301,6 +284,43 @@ double certification_radius(double s, const Eigen::Vector3d& r, double mu, doubl
   return (b + std::sqrt(discriminant)) / (2 * s) * (1 + 1e-9) + 1e-9;
 }
 
+// Calls visit(k) for every ball whose centre lies within `radius` of x (and
+// a few more), or for every ball when the grid cannot narrow it down.
+template <class Visit>
+void visit_near(const BallGrid& grid, const std::vector<Ball>& balls, const Eigen::Vector3d& x, double radius,
+                Visit visit) {
+  if (!std::isfinite(radius) || !grid.within(x, radius, visit))
+    for (int k = 0; k < static_cast<int>(balls.size()); ++k) visit(k);
+}
+
+// The `count` balls of least power distance among those near x: only
+// candidates (the caller certifies its answer against every ball). The
+// (power, ball) pairs live in one array per thread: the oracle runs on
+// every vertex of a mesh, and an allocation per call showed.
+std::vector<int> least_power(const BallGrid& grid, const std::vector<Ball>& balls, const Eigen::Vector3d& x,
+                             size_t count) {
+  thread_local std::vector<std::pair<double, int>> buffer;
+  std::vector<std::pair<double, int>>& by_power = buffer;  // one look-up of the thread's copy, not one per use
+  const auto gather = [&](int k) { by_power.emplace_back(balls[static_cast<size_t>(k)].power(x), k); };
+  by_power.clear();
+  double radius = std::sqrt(std::max(grid.max_weight(), 0.0)) + 1.0;
+  bool all = false;
+  for (int growth = 0; growth < 128 && by_power.size() < count && !all; ++growth, radius *= 2) {
+    by_power.clear();
+    all = !grid.within(x, radius, gather);
+  }
+  if (all || by_power.empty()) {  // most of the grid, or x not a finite point
+    by_power.clear();
+    for (int k = 0; k < static_cast<int>(balls.size()); ++k) gather(k);
+  }
+  count = std::min(count, by_power.size());
+  std::nth_element(by_power.begin(), by_power.begin() + static_cast<long>(count - 1), by_power.end());
+  std::vector<int> out;
+  out.reserve(count + 8);
+  for (size_t a = 0; a < count; ++a) out.push_back(by_power[a].second);
+  return out;
+}
+
 }  // namespace
 
 OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
@@ -311,29 +331,7 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
     return none;
   }
   const Problem p{balls_, shrink_, x};
-  const int n = static_cast<int>(balls_.size());
-  // Candidates: the balls of smallest power distance among those near x,
-  // as (power, ball) pairs in one array, reused by the thread (the oracle
-  // runs on every vertex of a mesh: an allocation per call showed).
-  thread_local std::vector<std::pair<double, int>> buffer;
-  std::vector<std::pair<double, int>>& by_power = buffer;  // one look-up of the thread's copy, not one per use
-  by_power.clear();
-  double radius = std::sqrt(std::max(grid_->max_weight(), 0.0)) + 1.0;
-  bool all = false;
-  for (int growth = 0; growth < 128 && by_power.size() < 24 && !all; ++growth, radius *= 2) {
-    by_power.clear();
-    all = !grid_->within(x, radius, [&](int k) { by_power.emplace_back(balls_[static_cast<size_t>(k)].power(x), k); });
-  }
-  if (all || by_power.empty()) {  // most of the grid, or x not a finite point
-    by_power.resize(static_cast<size_t>(n));
-    for (int k = 0; k < n; ++k) by_power[static_cast<size_t>(k)] = {balls_[static_cast<size_t>(k)].power(x), k};
-  }
-  // The 24 of least power.
-  const size_t count = std::min<size_t>(24, by_power.size());
-  std::nth_element(by_power.begin(), by_power.begin() + static_cast<long>(count - 1), by_power.end());
-  std::vector<int> candidates;
-  candidates.reserve(count + 8);
-  for (size_t a = 0; a < count; ++a) candidates.push_back(by_power[a].second);
+  std::vector<int> candidates = least_power(*grid_, balls_, x, 24);
   OracleResult out;
   for (int round = 0; round < 50; ++round) {
     const Solution sol = solve_on(p, candidates);
@@ -349,9 +347,7 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
         violators.push_back(k);
       violation = std::max(violation, gap);
     };
-    const double reach = certification_radius(shrink_, st.r, st.mu, grid_->max_weight());
-    if (!std::isfinite(reach) || !grid_->within(x, reach, check))  // no bound: check all
-      for (int k = 0; k < n; ++k) check(k);
+    visit_near(*grid_, balls_, x, certification_radius(shrink_, st.r, st.mu, grid_->max_weight()), check);
     out.kkt_violation = violation;
     out.certified = violation < 1e-9;
     if (violators.empty()) break;
@@ -382,12 +378,27 @@ MorphOracleResult end_result(const OracleResult& o, bool source_end) {
   return out;
 }
 
-// Gradient entries g_i = -2(1-s) <r, z_i - x> + s pi_i(x) of one side's balls.
-std::vector<double> side_gradient(const std::vector<Ball>& balls, const std::vector<double>& power,
-                                  const Eigen::Vector3d& x, const Eigen::Vector3d& r, double s) {
-  std::vector<double> g(balls.size());
-  for (size_t i = 0; i < balls.size(); ++i) g[i] = -2 * (1 - s) * r.dot(balls[i].center - x) + s * power[i];
-  return g;
+// The least multiplier g_k = -2(1-s) <r, z_k - x> + s pi_k(x) over one
+// side's balls: the least among the balls near x, certified for the rest by
+// the bound of certification_radius (a ball with g_k below a value lies
+// within that value's radius), so the pass is over the near balls only.
+struct Least {
+  int ball = -1;
+  double g = INFINITY;
+};
+Least least_multiplier(const BallGrid& grid, const Problem& side, const Eigen::Vector3d& r) {
+  Least least;
+  const auto take = [&](int k) {
+    const double g = side.gradient_entry(k, r);
+    if (g < least.g) least = {k, g};
+  };
+  const double near = std::sqrt(std::max(grid.max_weight(), 0.0)) + 1.0;
+  visit_near(grid, side.balls, side.x, near, take);
+  // Balls beyond `reach` have g_k >= least.g; one more pass settles it
+  // (least.g only falls, so the reach of its result is no larger).
+  const double reach = certification_radius(side.s, r, least.g, grid.max_weight());
+  if (!(reach <= near)) visit_near(grid, side.balls, side.x, reach, take);
+  return least;
 }
 
 }  // namespace
@@ -399,11 +410,11 @@ MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t) cons
   const double s = source_.shrink();
   const std::vector<Ball>& A = source_.balls();
   const std::vector<Ball>& B = target_.balls();
-  const std::vector<double> power_a = powers(A, x), power_b = powers(B, x);
+  const Problem side_a{A, s, x}, side_b{B, s, x};
   // Candidates: every pair of a few balls of least power on each side.
   std::vector<BallPair> pairs;
-  for (int i : smallest(power_a, 6))
-    for (int j : smallest(power_b, 6)) pairs.push_back({i, j});
+  for (int i : least_power(*source_.grid_, A, x, 6))
+    for (int j : least_power(*target_.grid_, B, x, 6)) pairs.push_back({i, j});
   MorphOracleResult out;
   for (int round = 0; round < 50; ++round) {
     const std::vector<Ball> balls = interpolated_balls(A, B, pairs, t);
@@ -414,21 +425,25 @@ MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t) cons
     const Stationary st = stationary(p, sol);
     take_solution(out, st, sol, [&](int candidate) { return pairs[static_cast<size_t>(candidate)]; });
     // Pair (i, j)'s multiplier is (1-t) g_i + t g_j, least at the least of each side.
-    const std::vector<double> ga = side_gradient(A, power_a, x, st.r, s), gb = side_gradient(B, power_b, x, st.r, s);
-    const int ia = static_cast<int>(std::min_element(ga.begin(), ga.end()) - ga.begin());
-    const int jb = static_cast<int>(std::min_element(gb.begin(), gb.end()) - gb.begin());
-    const double least = (1 - t) * ga[static_cast<size_t>(ia)] + t * gb[static_cast<size_t>(jb)];
+    const Least a = least_multiplier(*source_.grid_, side_a, st.r), b = least_multiplier(*target_.grid_, side_b, st.r);
+    const double least = (1 - t) * a.g + t * b.g;
     out.kkt_violation = std::max(st.violation, (st.mu - least) / st.scale);
     out.certified = out.kkt_violation < 1e-9;
+    if (!((st.mu - least) / st.scale > 1e-12)) break;  // no pair violates
+    // Violators paired with the other side's least: on side A those with
+    // g_i < (mu - t g_b) / (1-t), which lie within that value's reach.
     std::vector<BallPair> violators;
     auto add = [&](BallPair pair) {
-      const double g = (1 - t) * ga[static_cast<size_t>(pair.source)] + t * gb[static_cast<size_t>(pair.target)];
+      const double g = (1 - t) * side_a.gradient_entry(pair.source, st.r) + t * side_b.gradient_entry(pair.target, st.r);
       if ((st.mu - g) / st.scale > 1e-12 && std::find(pairs.begin(), pairs.end(), pair) == pairs.end() &&
           std::find(violators.begin(), violators.end(), pair) == violators.end())
         violators.push_back(pair);
     };
-    for (int i = 0; i < static_cast<int>(A.size()); ++i) add({i, jb});
-    for (int j = 0; j < static_cast<int>(B.size()); ++j) add({ia, j});
+    const double below_a = (st.mu - t * b.g) / (1 - t), below_b = (st.mu - (1 - t) * a.g) / t;
+    visit_near(*source_.grid_, A, x, certification_radius(s, st.r, below_a, source_.grid_->max_weight()),
+               [&](int i) { add({i, b.ball}); });
+    visit_near(*target_.grid_, B, x, certification_radius(s, st.r, below_b, target_.grid_->max_weight()),
+               [&](int j) { add({a.ball, j}); });
     if (violators.empty()) break;
     pairs.insert(pairs.end(), violators.begin(), violators.end());
   }

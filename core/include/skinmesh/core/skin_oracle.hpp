@@ -44,6 +44,7 @@ class SkinOracle {
   // Balls far from x are certified by a bound instead of one by one
   // (evaluate); the grid finds the near ones.
   std::shared_ptr<const BallGrid> grid_;
+  friend class MorphOracle;  // certifies each side's balls with its grid the same way
 };
 
 // The skin function of every frame of a morph (docs/math.md section 4):
@@ -52,9 +53,12 @@ class SkinOracle {
 // which equals the skin function of all m*n interpolated balls b_ij(t). It is
 // solved over a few candidate pairs and certified against every pair: a pair's
 // optimality multiplier is (1-t) g_i + t g_j with g_i, g_j the source's and
-// target's own, so the check over all m*n pairs costs O(m + n). Like
-// SkinOracle it never builds a triangulation, and it never asks which pairs
-// are live: an independent reference for every frame of a morph.
+// target's own, so the check over all m*n pairs needs only each side's least
+// multiplier: found among each side's balls near x (its grid) and certified
+// for the rest by the bound SkinOracle uses, so a point costs what its
+// neighbourhood holds, not m + n. Like SkinOracle it never builds a
+// triangulation, and it never asks which pairs are live: an independent
+// reference for every frame of a morph.
 struct MorphOracleResult {
   double value = 0.0;                                  // F_t(x), Angstrom^2
   Eigen::Vector3d gradient = Eigen::Vector3d::Zero();  // 2 (x - (1-t) Z_A l* - t Z_B u*)
