@@ -30,7 +30,7 @@ MeshingOptions MorphOptions::repair_criteria() const {
   return r;
 }
 
-MeshingOptions MorphOptions::first_criteria() const { return with_size_margin(first, repair_size_margin); }
+MeshingOptions MorphOptions::first_criteria() const { return with_size_margin(first, first_size_margin); }
 
 Morph::Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
              const MorphOptions& options)

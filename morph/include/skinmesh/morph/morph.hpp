@@ -53,21 +53,25 @@ struct MorphOptions {
   // model 1 -> 3 and pept -> 3al1, 30 frames: with 3-4% failing, local
   // repair took 0.28 and 0.71 s a frame against 0.14 and 0.60 s). 0: never.
   double local_repair_share = 0.01;
-  // Repairs (local and whole-frame) refine to stricter sizes than frames
-  // are accepted at, so that a repaired triangle has room to move before it
-  // fails again: epsilon, the edge length cap and the tolerance times the
-  // size margin; the angle bound may be raised too (at most 30 degrees).
-  // Measured 2026-11-24 (100 frames; a frame's seconds, triangles, frames
-  // remeshed): pept -> 3al1 with +5 degrees and 0.85 0.169 s, 20,361, 99 of
-  // 99; with 0.85 alone 0.152 s, 18,649, 99; with neither 0.122 s, 15,004,
-  // 99. 2k39 model 1 -> 3: 0.069, 69 of 99; 0.068, 74; 0.054, 86. The angle
-  // margin bought nothing; the size margin is what lets frames of a benign
-  // motion pass by transport alone (two balls moving apart: 2 of 18 frames
-  // with it, none without), so it stays.
+  // Repairs (local and whole-frame) may refine to stricter criteria than
+  // frames are accepted at, so that a repaired triangle has room to move
+  // before it fails again: the angle bound raised by the angle margin (at
+  // most 30 degrees), epsilon, the edge length cap and the tolerance times
+  // the size margin. The first frame's mesh takes its own size margin. Only
+  // that one pays: frames of a benign motion pass by transport alone after
+  // a first frame meshed with room (two balls moving apart: its first 2 of
+  // 18 frames; none with 1.0 there), while room at the repairs bought none
+  // (every later frame of the two balls was repaired either way) and made
+  // frames larger and slower. 100 frames, 2026-11-24, a frame's seconds,
+  // triangles and frames remeshed: pept -> 3al1 with +5 degrees and 0.85
+  // (the earlier defaults) 0.169 s, 20,361, 99 of 99; 0.85 alone 0.156 s,
+  // 18,649, 99; neither 0.127 s, 15,070, 99. 2k39 model 1 -> 3: 0.069 s,
+  // 69; 0.068 s, 74; 0.054 s, 86.
   double repair_angle_margin = 0.0;  // degrees
-  double repair_size_margin = 0.85;
+  double repair_size_margin = 1.0;
+  double first_size_margin = 0.85;
   MeshingOptions repair_criteria() const;
-  MeshingOptions first_criteria() const;  // `first` with the size margin
+  MeshingOptions first_criteria() const;  // `first` with the first frame's size margin
 };
 
 struct FrameStats {
