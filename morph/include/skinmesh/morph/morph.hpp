@@ -45,8 +45,11 @@ struct MorphOptions {
   // edge length to a neighbour along a mesh edge is removed (transport
   // crowds vertices where a patch shrinks; refinement puts back what the
   // criteria need). Measured on 2k39 model 1 -> 3 in 10 steps: 0.2 let the
-  // vertex count double by t = 0.6, 0.4 kept it within 3,000-4,300.
-  double crowded_below = 0.4;
+  // vertex count double by t = 0.6, 0.4 kept it within 3,000-4,300. Over 100
+  // frames (2026-11-24, a frame's seconds and triangles): pept -> 3al1 0.4
+  // 0.128 s, 15,070; 0.5 0.124 s, 13,482; 0.6 0.127 s, 12,589. 2k39 model 1
+  // -> 3: 0.054 s, 6,861; 0.053 s, 6,143; 0.056 s, 5,754.
+  double crowded_below = 0.5;
   // Local repair is tried when at most this share of the triangles fails
   // after transport; past it the patches cover much of the mesh and
   // remeshing the whole frame from its vertices is faster (measured on 2k39
