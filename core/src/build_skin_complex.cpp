@@ -6,6 +6,8 @@
 #include "regular_triangulation.hpp"
 
 #include <Eigen/Dense>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -43,9 +45,10 @@ void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
     rhs[j] = E.col(j).squaredNorm() - bj.weight + b0.weight;
   }
   const Mat gram = E.transpose() * E;
-  Eigen::SelfAdjointEigenSolver<Mat> eig(gram);
-  const double largest = eig.eigenvalues().maxCoeff();
-  const double smallest = eig.eigenvalues().minCoeff();
+  // Eigenvalues only: the vectors are needed for a flat simplex alone.
+  const Vec values = Eigen::SelfAdjointEigenSolver<Mat>(gram, Eigen::EigenvaluesOnly).eigenvalues();
+  const double largest = values.maxCoeff();
+  const double smallest = values.minCoeff();
   Mat gram_inv;
   if (smallest > 1e-14 * largest) {
     gram_inv = gram.inverse();
@@ -53,6 +56,7 @@ void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
     // Affinely dependent vertices (a flat simplex from cospherical input):
     // pseudo-inverse on the span that exists.
     cell.degenerate = true;
+    const Eigen::SelfAdjointEigenSolver<Mat> eig(gram);
     Vec inv = eig.eigenvalues();
     for (int i = 0; i < d; ++i) inv[i] = inv[i] > 1e-14 * largest ? 1.0 / inv[i] : 0.0;
     gram_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
@@ -255,10 +259,15 @@ struct SkinComplexBuilder {
     check_finite(balls);
     SkinComplex sc = from;
     sc.balls_ = std::move(balls);
-    for (MixedCell& c : sc.cells_) {
-      c.degenerate = false;
-      compute_cell_geometry(c, sc.balls_);
-    }
+    // Each cell on its own, on every core: a morph moves the complex every
+    // frame, and serially this was a tenth of a frame (pept -> 3al1: 15 ms
+    // of 0.14 s; 1ubi -> 1hpv 120 ms).
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, sc.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t c = r.begin(); c != r.end(); ++c) {
+        sc.cells_[c].degenerate = false;
+        compute_cell_geometry(sc.cells_[c], sc.balls_);
+      }
+    });
     build_start_grid(sc);
     return sc;
   }
