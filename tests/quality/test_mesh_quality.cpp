@@ -17,6 +17,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -255,6 +257,64 @@ TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {
     CHECK(q.volume == Approx(expected.volume).epsilon(1e-6));
   }
   std::remove((f_vert.path().substr(0, f_vert.path().size() - 5) + ".face").c_str());
+}
+
+TEST_CASE("binary PLY: every scalar type, in either byte order", "[quality][io]") {
+  // One triangle whose coordinates are each stored in another type, with a
+  // property of every other type beside them (skipped by its size), and
+  // indices in a list counted by a ushort; written big and little endian.
+  const std::vector<std::string> names = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double"};
+  auto put = [](std::string& out, const void* bytes, int n, bool big) {
+    std::string b(static_cast<const char*>(bytes), static_cast<size_t>(n));
+    if (big) std::reverse(b.begin(), b.end());
+    out += b;
+  };
+  auto value = [&](std::string& out, const std::string& type, double v, bool big) {
+    if (type == "char") { const int8_t x = static_cast<int8_t>(v); put(out, &x, 1, big); }
+    if (type == "uchar") { const uint8_t x = static_cast<uint8_t>(v); put(out, &x, 1, big); }
+    if (type == "short") { const int16_t x = static_cast<int16_t>(v); put(out, &x, 2, big); }
+    if (type == "ushort") { const uint16_t x = static_cast<uint16_t>(v); put(out, &x, 2, big); }
+    if (type == "int") { const int32_t x = static_cast<int32_t>(v); put(out, &x, 4, big); }
+    if (type == "uint") { const uint32_t x = static_cast<uint32_t>(v); put(out, &x, 4, big); }
+    if (type == "float") { const float x = static_cast<float>(v); put(out, &x, 4, big); }
+    if (type == "double") put(out, &v, 8, big);
+  };
+  const double corners[3][3] = {{-3, 2, 5}, {7, -1, 4}, {1, 6, -2}};
+  for (bool big : {false, true}) {
+    for (size_t first = 0; first < names.size(); ++first) {
+      // x, y, z in three consecutive types (wrapping), every type as a filler before x.
+      const std::string tx = names[first], ty = names[(first + 1) % names.size()], tz = names[(first + 2) % names.size()];
+      // Unsigned types hold their coordinate shifted past the signed type's
+      // range, so that reading one as the other fails.
+      auto shift = [](const std::string& type) {
+        return type == "uchar" ? 200.0 : type == "ushort" ? 40000.0 : type == "uint" ? 3e9 : 0.0;
+      };
+      const Eigen::Vector3d offset(shift(tx), shift(ty), shift(tz));
+      std::string header = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+                           " 1.0\nelement vertex 3\n";
+      for (const std::string& t : names) header += "property " + t + " filler_" + t + "\n";
+      header += "property " + tx + " x\nproperty " + ty + " y\nproperty " + tz + " z\n";
+      header += "element face 1\nproperty list ushort uint vertex_indices\nend_header\n";
+      std::string body;
+      for (int v = 0; v < 3; ++v) {
+        for (const std::string& t : names) value(body, t, 1, big);
+        value(body, tx, corners[v][0] + offset.x(), big);
+        value(body, ty, corners[v][1] + offset.y(), big);
+        value(body, tz, corners[v][2] + offset.z(), big);
+      }
+      value(body, "ushort", 3, big);
+      for (int k : {0, 1, 2}) value(body, "uint", k, big);
+      CAPTURE(big, tx, ty, tz);
+      test::TempFile file("types.ply", header + body);
+      const SurfaceMesh m = read_surface_mesh(file.path());
+      REQUIRE(m.vertices.size() == 3);
+      REQUIRE(m.triangles.size() == 1);
+      for (int v = 0; v < 3; ++v)
+        CHECK((m.vertices[static_cast<size_t>(v)] - Eigen::Vector3d(corners[v][0], corners[v][1], corners[v][2]) -
+               offset).norm() == 0.0);
+      CHECK(m.triangles[0] == std::array<int, 3>{0, 1, 2});
+    }
+  }
 }
 
 TEST_CASE("OFF in free format (records running on across lines) reads", "[quality][io]") {

@@ -272,8 +272,35 @@ SurfaceMesh read_stl(const std::string& path) {
   return mesh;
 }
 
+// A PLY scalar type, parsed once from the header: the body's values are read
+// by it (comparing type names per value was a quarter of `skinmesh quality`
+// on a binary mesh).
+enum class PlyType : unsigned char { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
+
+PlyType ply_type(const std::string& t, const std::string& path) {
+  if (t == "char" || t == "int8") return PlyType::int8;
+  if (t == "uchar" || t == "uint8") return PlyType::uint8;
+  if (t == "short" || t == "int16") return PlyType::int16;
+  if (t == "ushort" || t == "uint16") return PlyType::uint16;
+  if (t == "int" || t == "int32") return PlyType::int32;
+  if (t == "uint" || t == "uint32") return PlyType::uint32;
+  if (t == "float" || t == "float32") return PlyType::float32;
+  if (t == "double" || t == "float64") return PlyType::float64;
+  input_error(path, 0, "unknown PLY property type '" + t + "'");
+}
+
+size_t ply_type_size(PlyType t) {
+  switch (t) {
+    case PlyType::int8: case PlyType::uint8: return 1;
+    case PlyType::int16: case PlyType::uint16: return 2;
+    case PlyType::float64: return 8;
+    default: return 4;
+  }
+}
+
 struct PlyProperty {
   std::string name, type, count_type;  // count_type non-empty for lists
+  PlyType value = PlyType::float64, count = PlyType::uint8;  // parsed type and count_type
 };
 struct PlyElement {
   std::string name;
@@ -286,14 +313,6 @@ struct PlyHeader {
   size_t body = 0;     // offset of the first byte after the header
 };
 
-size_t ply_type_size(const std::string& t, const std::string& path) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
-  input_error(path, 0, "unknown PLY property type '" + t + "'");
-}
-
 // Refuses element counts the body cannot hold before any is read: a record
 // takes at least the bytes of its scalar properties and list counts (binary),
 // or two characters a value (text). A header may otherwise declare 10^18
@@ -305,7 +324,7 @@ void check_ply_counts(const PlyHeader& h, size_t body_bytes, const std::string& 
     if (e.count < 0) input_error(path, 0, "PLY element '" + e.name + "' has a negative count");
     size_t record = 0;
     for (const PlyProperty& p : e.properties)
-      record += ascii ? 2 : ply_type_size(p.count_type.empty() ? p.type : p.count_type, path);
+      record += ascii ? 2 : ply_type_size(p.count_type.empty() ? p.value : p.count);
     needed += static_cast<double>(e.count) * static_cast<double>(record);
     if (needed - (ascii ? 1 : 0) > static_cast<double>(body_bytes))  // text: no separator after the last value
       input_error(path, 0, "PLY element '" + e.name + "' declares " + std::to_string(e.count) +
@@ -340,8 +359,9 @@ PlyHeader read_ply_header(const std::string& data, const std::string& path) {
       w >> p.name;
       // Checked in every format: an ASCII body is read as numbers whatever
       // the header says, so a wrong type would pass unseen.
-      ply_type_size(p.type, path);
-      if (!p.count_type.empty() && (ply_type_size(p.count_type, path) == 8 || p.count_type.find("float") == 0))
+      p.value = ply_type(p.type, path);
+      if (!p.count_type.empty()) p.count = ply_type(p.count_type, path);
+      if (!p.count_type.empty() && (p.count == PlyType::float32 || p.count == PlyType::float64))
         input_error(path, number, "PLY list '" + p.name + "' needs an integer count type, not " + p.count_type);
       h.elements.back().properties.push_back(p);
     }
@@ -359,25 +379,28 @@ class PlyValues {
       : data_(data), path_(path), ascii_(header.format == "ascii"), swap_(header.format == "binary_big_endian"),
         pos_(header.body), text_(ascii_ ? data.substr(header.body) : std::string()) {}
 
-  double next(const std::string& type) {
+  double next(PlyType type) {
     if (ascii_) {
       double v;
       if (!(text_ >> v)) input_error(path_, 0, "PLY body ends early or holds a non-number");
       return v;
     }
-    const size_t n = ply_type_size(type, path_);
+    const size_t n = ply_type_size(type);
     if (pos_ + n > data_.size()) input_error(path_, 0, "PLY body ends early");
     unsigned char b[8];
     std::memcpy(b, data_.data() + pos_, n);
     pos_ += n;
     if (swap_) std::reverse(b, b + n);
-    if (type == "float" || type == "float32") { float f; std::memcpy(&f, b, 4); return f; }
-    if (type == "double" || type == "float64") { double d; std::memcpy(&d, b, 8); return d; }
-    if (type == "char" || type == "int8") return static_cast<int8_t>(b[0]);
-    if (type == "uchar" || type == "uint8") return b[0];
-    if (type == "short" || type == "int16") { int16_t v; std::memcpy(&v, b, 2); return v; }
-    if (type == "ushort" || type == "uint16") { uint16_t v; std::memcpy(&v, b, 2); return v; }
-    if (type == "int" || type == "int32") { int32_t v; std::memcpy(&v, b, 4); return v; }
+    switch (type) {
+      case PlyType::float32: { float f; std::memcpy(&f, b, 4); return f; }
+      case PlyType::float64: { double d; std::memcpy(&d, b, 8); return d; }
+      case PlyType::int8: return static_cast<int8_t>(b[0]);
+      case PlyType::uint8: return b[0];
+      case PlyType::int16: { int16_t v; std::memcpy(&v, b, 2); return v; }
+      case PlyType::uint16: { uint16_t v; std::memcpy(&v, b, 2); return v; }
+      case PlyType::int32: { int32_t v; std::memcpy(&v, b, 4); return v; }
+      case PlyType::uint32: break;
+    }
     uint32_t v;
     std::memcpy(&v, b, 4);
     return v;
@@ -404,28 +427,37 @@ SurfaceMesh read_ply(const std::string& path) {
         input_error(path, 0, "PLY element '" + e.name + "' has no properties");
       continue;
     }
+    // What each property is, decided once per element, not per record.
+    const bool vertex = e.name == "vertex", face = e.name == "face";
+    std::vector<int> role(e.properties.size(), -1);  // 0-2: x, y, z of a vertex; 3: a face's vertex indices
+    for (size_t k = 0; k < role.size(); ++k) {
+      const PlyProperty& p = e.properties[k];
+      if (vertex && p.count_type.empty() && (p.name == "x" || p.name == "y" || p.name == "z")) role[k] = p.name[0] - 'x';
+      if (face && !p.count_type.empty() && (p.name == "vertex_indices" || p.name == "vertex_index")) role[k] = 3;
+    }
+    std::vector<long> corners;
     for (long i = 0; i < e.count; ++i) {
       double xyz[3] = {NAN, NAN, NAN};
-      std::vector<long> corners;
-      for (const PlyProperty& p : e.properties) {
+      corners.clear();
+      for (size_t k = 0; k < role.size(); ++k) {
+        const PlyProperty& p = e.properties[k];
         if (!p.count_type.empty()) {
-          const double count = values.next(p.count_type);
+          const double count = values.next(p.count);
           if (!is_whole_number(count) || count < 0)
             input_error(path, 0, "PLY " + e.name + " " + std::to_string(i) + ": bad list length");
-          const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
-          for (long k = 0; k < static_cast<long>(count); ++k) {
-            const double v = values.next(p.type);
-            if (!indices) continue;
+          for (long c = 0; c < static_cast<long>(count); ++c) {
+            const double v = values.next(p.value);
+            if (role[k] != 3) continue;
             if (!is_whole_number(v)) input_error(path, 0, "PLY face " + std::to_string(i) + ": vertex index is not an integer");
             corners.push_back(static_cast<long>(v));
           }
         } else {
-          const double v = values.next(p.type);
-          if (e.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z")) xyz[p.name[0] - 'x'] = v;
+          const double v = values.next(p.value);
+          if (role[k] >= 0) xyz[role[k]] = v;
         }
       }
-      if (e.name == "vertex") mesh.vertices.push_back(checked_point(xyz[0], xyz[1], xyz[2], path, 0));
-      if (e.name == "face") add_polygon(mesh, corners, path, 0);
+      if (vertex) mesh.vertices.push_back(checked_point(xyz[0], xyz[1], xyz[2], path, 0));
+      if (face) add_polygon(mesh, corners, path, 0);
     }
   }
   return mesh;
