@@ -251,6 +251,8 @@ class Refiner {
   // the triangulation changes elsewhere.
   FacetEval evaluate(const FacetShape& shape) const;
   FacetEval evaluate(const Facet& facet) const { return evaluate(shape_of(facet)); }
+  // Whether the Voronoi edge lies strictly inside the body, by one ball: no crossing.
+  bool inside_a_shrunk_ball(const DualEdge& edge, const std::array<Vertex_handle, 3>& corners) const;
   std::optional<DualEdge> dual_edge(const FacetShape& shape, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                                     const Eigen::Vector3d& p2) const;
   // Seeds closer than spacing times the target edge length to a sample are left out.
