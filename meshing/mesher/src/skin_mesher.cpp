@@ -89,6 +89,7 @@ FacetShape Refiner::shape_of(const Facet& facet) const {
 bool Refiner::inside_a_shrunk_ball(const DualEdge& edge, const std::array<Vertex_handle, 3>& corners) const {
   constexpr double kStrictly = 1 - 1e-9;  // far above the walk's rounding: its answer would be the same
   for (const Vertex_handle& v : corners) {
+    if (v->info().cell < 0) continue;  // no cell recorded: nothing to try here
     const MixedCell& cell = complex_.cell(v->info().cell);
     for (int j = 0; j <= cell.dim; ++j) {
       const Ball& ball = complex_.balls()[static_cast<size_t>(cell.balls[static_cast<size_t>(j)])];
