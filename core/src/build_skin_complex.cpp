@@ -254,22 +254,24 @@ struct SkinComplexBuilder {
     for (int i : live) sc.grid_balls_[static_cast<size_t>(cursor[bucket_of(i)]++)] = i;
   }
 
-  static SkinComplex moved(const SkinComplex& from, std::vector<Ball> balls) {
+  // `out` = `from` with its balls moved; copy-assigned, so that a complex
+  // moved before keeps its allocations.
+  static void moved(const SkinComplex& from, std::vector<Ball> balls, SkinComplex& out) {
     if (balls.size() != from.balls_.size()) contract_error("with_balls: the number of balls differs from the complex's");
+    if (&out == &from) contract_error("with_balls: the complex cannot be moved onto itself");
     check_finite(balls);
-    SkinComplex sc = from;
-    sc.balls_ = std::move(balls);
+    out = from;
+    out.balls_ = std::move(balls);
     // Each cell on its own, on every core: a morph moves the complex every
     // frame, and serially this was a tenth of a frame (pept -> 3al1: 15 ms
     // of 0.14 s; 1ubi -> 1hpv 120 ms).
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, sc.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, out.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t c = r.begin(); c != r.end(); ++c) {
-        sc.cells_[c].degenerate = false;
-        compute_cell_geometry(sc.cells_[c], sc.balls_);
+        out.cells_[c].degenerate = false;
+        compute_cell_geometry(out.cells_[c], out.balls_);
       }
     });
-    build_start_grid(sc);
-    return sc;
+    build_start_grid(out);
   }
 
   static SkinComplex build(std::vector<Ball> balls, const SkinComplexOptions& options) {
@@ -299,19 +301,26 @@ struct SkinComplexBuilder {
 };
 
 SkinComplex SkinComplex::with_balls(std::vector<Ball> balls) const {
-  return SkinComplexBuilder::moved(*this, std::move(balls));
+  SkinComplex sc;
+  SkinComplexBuilder::moved(*this, std::move(balls), sc);
+  return sc;
 }
 
 SkinComplex SkinComplex::with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known) const {
-  SkinComplex sc = SkinComplexBuilder::moved(*this, std::move(balls));
+  SkinComplex sc;
+  with_balls(std::move(balls), known, sc);
+  return sc;
+}
+
+void SkinComplex::with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known, SkinComplex& out) const {
+  SkinComplexBuilder::moved(*this, std::move(balls), out);
   for (const KnownCell& k : known) {
     if (k.cell < 0 || k.cell >= static_cast<int>(cells_.size())) contract_error("with_balls: a known cell out of range");
-    MixedCell& cell = sc.cells_[static_cast<size_t>(k.cell)];
+    MixedCell& cell = out.cells_[static_cast<size_t>(k.cell)];
     cell.center = k.center;
     cell.R2 = k.R2;
     cell.P = cells_[static_cast<size_t>(k.cell)].P;
   }
-  return sc;
 }
 
 bool SkinComplex::same_flat_cells(const SkinComplex& other) const {

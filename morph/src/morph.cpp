@@ -227,7 +227,8 @@ const MorphFrame& Morph::advance_to(double t) {
     finish_frame(t, start);
     return frame_;
   }
-  SkinComplex next = overlay_at(t);
+  overlay_at(t, spare_);
+  const SkinComplex& next = spare_;
   SurfaceMesh moved = frame_.mesh;
   std::vector<char> drop = move_vertices(next, moved, stats);
   std::vector<char> failing;
@@ -248,7 +249,7 @@ const MorphFrame& Morph::advance_to(double t) {
     }
     frame_.stats.seconds_repair = seconds_since(repair_start);
   }
-  current_ = std::move(next);  // a copy of the complex was 1% of a frame (perf, pept -> 3al1)
+  std::swap(current_, spare_);  // a copy of the complex was 1% of a frame (perf, pept -> 3al1)
   finish_frame(t, start);
   return frame_;
 }
@@ -261,10 +262,16 @@ const MorphFrame& Morph::advance_to(double t) {
 // CGAL's skin sign, and the command refused t = 0.999 (1.27e-8 A); with the
 // curves, 1.2e-13 A (bench/morph_precision).
 SkinComplex Morph::overlay_at(double t) const {
+  SkinComplex out;
+  overlay_at(t, out);
+  return out;
+}
+
+void Morph::overlay_at(double t, SkinComplex& out) const {
   std::vector<SkinComplex::KnownCell> known;
   for (size_t c = 0; c < sizes_.size(); ++c)
     if (sizes_[c].overlay_cell) known.push_back({static_cast<int>(c), sizes_[c].center(t), sizes_[c].at(t)});
-  return middle_.with_balls(interpolated_balls(source_, target_, pairs_, t), known);
+  middle_.with_balls(interpolated_balls(source_, target_, pairs_, t), known, out);
 }
 
 std::vector<std::array<int, 2>> Morph::vertex_atoms() const {

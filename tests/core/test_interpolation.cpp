@@ -126,3 +126,36 @@ TEST_CASE("with_balls with known cells: those take the given centre and size and
   const int past = static_cast<int>(middle.cells().size());
   CHECK_THROWS_AS(middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{past, centre, 0.0}}), ContractError);
 }
+
+TEST_CASE("with_balls into a complex moved before: every cell and ball as a fresh move makes them", "[interpolation]") {
+  const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
+  const auto m2 = test::centred_model(test::data_file("2k39_3models.pdb"), 2);
+  const auto live = live_pairs(m1, m2);
+  const SkinComplex middle = build_skin_complex(interpolated_balls(m1, m2, live, 0.5), {0.5});
+  int edge = 0;
+  while (middle.cell(edge).dim != 1) ++edge;
+  const std::vector<SkinComplex::KnownCell> known{{edge, Eigen::Vector3d(0.5, 1.0, -1.0), 0.25}};
+  // The storage of another complex (the source's own, other cells) and of a
+  // frame moved before: neither may leave anything behind.
+  SkinComplex reused = build_skin_complex(m1, {0.5});
+  for (double t : {0.2, 0.7}) {
+    middle.with_balls(interpolated_balls(m1, m2, live, t), known, reused);
+    const SkinComplex fresh = middle.with_balls(interpolated_balls(m1, m2, live, t), known);
+    REQUIRE(reused.cells().size() == fresh.cells().size());
+    REQUIRE(reused.balls().size() == fresh.balls().size());
+    for (size_t b = 0; b < fresh.balls().size(); ++b) {
+      CHECK(reused.balls()[b].center == fresh.balls()[b].center);
+      CHECK(reused.balls()[b].weight == fresh.balls()[b].weight);
+    }
+    for (size_t c = 0; c < fresh.cells().size(); ++c) {
+      const MixedCell &a = reused.cells()[c], &b = fresh.cells()[c];
+      CHECK((a.balls == b.balls && a.center == b.center && a.R2 == b.R2 && a.P == b.P && a.to_affine == b.to_affine &&
+             a.degenerate == b.degenerate));
+    }
+    // And it answers queries as the fresh one does (faces, cofaces, grid).
+    const Eigen::Vector3d x = fresh.cell(edge).center + Eigen::Vector3d(0.3, -0.2, 0.1);
+    CHECK(reused.locate(x) == fresh.locate(x));
+  }
+  SkinComplex self = middle;
+  CHECK_THROWS_AS(self.with_balls(interpolated_balls(m1, m2, live, 0.3), known, self), ContractError);
+}

@@ -137,11 +137,13 @@ class Morph {
 
   void reseat(const SkinComplex& next, FrameStats& stats);
   SkinComplex overlay_at(double t) const;
+  void overlay_at(double t, SkinComplex& out) const;  // into out's storage (see with_balls)
   void finish_frame(double t, Clock::time_point start);
 
   std::vector<Ball> source_, target_;
   std::vector<BallPair> pairs_;
   SkinComplex middle_, current_;
+  SkinComplex spare_;  // the complex of the frame before last: storage for the next frame's
   bool on_overlay_ = true;  // current_ is the overlay complex (cells numbered as middle_)
   MorphOptions options_;
   std::vector<CellSize> sizes_;  // per cell of middle_: its size and centre as functions of t
