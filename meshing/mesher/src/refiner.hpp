@@ -115,14 +115,19 @@ struct QueuedFacet {
 };
 
 // Where a batch of refinement found a restricted facet: the next global pass
-// evaluates these again instead of every facet the batches made (3mht: 0.33
-// of 2.3 million), while both cells still stand. 24 bytes: a list of whole
-// evaluations raised 3mht's peak by 26 MB.
+// takes these instead of every facet the batches made (3mht: 0.33 of 2.3
+// million), while both cells still stand. 24 bytes: a list of whole
+// evaluations raised 3mht's peak by 26 MB. The first kKeptBatchEvals
+// evaluations of a pass are kept whole all the same (5 MB at most), so that
+// the pass need not evaluate them again: a morph frame's remesh finds about
+// 8,000 (pept -> 3al1), a mesh of 1ubi 115,000.
 struct BatchFound {
   Cell_handle cell;  // FacetShape::cell and ::index
   unsigned stamp_c = 0, stamp_n = 0;
   int index = 0;
+  int eval = -1;  // position in Refiner::batch_evals_, or -1 when not kept
 };
+constexpr size_t kKeptBatchEvals = size_t{1} << 16;
 
 // Whether the link of a vertex (the opposite edges of its restricted
 // triangles) is one closed cycle: the vertex star is a disk.
@@ -308,6 +313,7 @@ class Refiner {
   // and the restricted facets they found there (cleaned up as cells go).
   std::vector<std::pair<unsigned, unsigned>> batch_stamps_;
   std::deque<BatchFound> batch_found_;
+  std::vector<FacetEval> batch_evals_;  // whole evaluations of batch_found_ (see BatchFound)
   size_t batch_found_after_cleanup_ = 0;
   std::vector<Cell_handle> star_;    // cells made by the last insertion
   // Cells made by insert() since made_since_ (a refinement batch), with

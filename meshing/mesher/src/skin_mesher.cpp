@@ -546,9 +546,15 @@ bool Refiner::still_stands(Cell_handle c, int index, unsigned stamp_c, unsigned 
 }
 
 void Refiner::keep_batch_found(const std::vector<FacetShape>& shapes, const std::vector<FacetEval>& evals) {
-  for (size_t k = 0; k < evals.size(); ++k)
-    if (evals[k].crossings > 0)
-      batch_found_.push_back({shapes[k].cell, shapes[k].stamp_c, shapes[k].stamp_n, shapes[k].index});
+  for (size_t k = 0; k < evals.size(); ++k) {
+    if (evals[k].crossings == 0) continue;
+    int kept = -1;
+    if (batch_evals_.size() < kKeptBatchEvals) {
+      kept = static_cast<int>(batch_evals_.size());
+      batch_evals_.push_back(evals[k]);
+    }
+    batch_found_.push_back({shapes[k].cell, shapes[k].stamp_c, shapes[k].stamp_n, shapes[k].index, kept});
+  }
   // Most facets found are replaced by later batches: drop those gone once
   // the list has grown by half, so that it stays near the live restricted count.
   if (batch_found_.size() < batch_found_after_cleanup_ + batch_found_after_cleanup_ / 2 + 65536) return;
@@ -596,8 +602,9 @@ bool Refiner::global_pass() {
   // facets of new cells are evaluated again, in chunks: about one facet in
   // seven is restricted, and an evaluation of every facet at once was half the
   // peak memory (1ubi: 51 of 110 MB, heaptrack). Of the facets refinement's
-  // batches evaluated, only the restricted ones they found are evaluated
-  // again: the others were not restricted then and are the same now.
+  // batches evaluated, only the restricted ones they found that still stand
+  // are taken, their evaluations as kept (BatchFound) or evaluated again:
+  // the others were not restricted then and are the same now.
   constexpr size_t kChunk = size_t{1} << 14;
   std::vector<Facet> facets;
   facets.reserve(kChunk);
@@ -645,13 +652,19 @@ bool Refiner::global_pass() {
   for (; !batch_found_.empty(); batch_found_.pop_front()) {
     const BatchFound& f = batch_found_.front();
     if (!still_stands(f.cell, f.index, f.stamp_c, f.stamp_n)) continue;
-    facets.emplace_back(batch_found_.front().cell, batch_found_.front().index);
+    // The same cells, hence the same Voronoi edge and evaluation.
+    if (f.eval >= 0) {
+      fresh.push_back(batch_evals_[static_cast<size_t>(f.eval)]);
+      continue;
+    }
+    facets.emplace_back(f.cell, f.index);
     if (facets.size() == kChunk) {
       keep_restricted(facets, &fresh);
       facets.clear();
     }
   }
   batch_found_after_cleanup_ = 0;
+  batch_evals_.clear();
   batch_stamps_.clear();
   keep_restricted(facets, &fresh);
   keep_pass(std::move(unchanged), std::move(fresh));
