@@ -7,7 +7,7 @@
 namespace skinmesh {
 
 double local_length(const SkinComplex& complex, const Eigen::Vector3d& x, int cell) {
-  const double k = complex.curvature(x, cell).max_abs();
+  const double k = complex.max_abs_curvature(x, cell);
   return k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
 }
 

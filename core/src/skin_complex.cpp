@@ -458,6 +458,27 @@ void SkinComplex::intersect_segment(const Eigen::Vector3d& a, const Eigen::Vecto
   }
 }
 
+double SkinComplex::max_abs_curvature(const Eigen::Vector3d& x, int c) const {
+  const MixedCell& cell = cells_[static_cast<size_t>(c)];
+  const double s = shrink_;
+  const Eigen::Vector3d y = x - cell.center;
+  const Eigen::Vector3d g = skin_gradient(s, y, cell.P * y);
+  const double gn = g.norm();
+  if (gn == 0.0) return 0.0;
+  // As curvature(): S = T^T H T / |g| with H = 2 (I - P) - 2s/(1-s) P, whose
+  // eigenvalues m +- r give max |k| = |m| + r.
+  const Eigen::Vector3d n = g / gn;
+  const Eigen::Vector3d t1 = n.unitOrthogonal();
+  const Eigen::Vector3d t2 = n.cross(t1);
+  const double h = 2.0 * s / (1 - s);
+  auto shape = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    return (2.0 * u.dot(v) - (2.0 + h) * u.dot(cell.P * v)) / gn;
+  };
+  const double a = shape(t1, t1), b = shape(t1, t2), d = shape(t2, t2);
+  const double m = 0.5 * (a + d);
+  return std::abs(m) + std::hypot(0.5 * (a - d), b);
+}
+
 PrincipalCurvatures SkinComplex::curvature(const Eigen::Vector3d& x, int c) const {
   const MixedCell& cell = cells_[static_cast<size_t>(c)];
   const double s = shrink_;

@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace skinmesh;
@@ -18,6 +19,7 @@ TEST_CASE("a lone ball's skin has curvature 1/radius", "[curvature]") {
     CHECK(pc.k1 == Approx(1 / radius).epsilon(1e-12));
     CHECK(pc.k2 == Approx(1 / radius).epsilon(1e-12));
     CHECK(local_length(sc, x, sc.locate(x)) == Approx(radius).epsilon(1e-12));
+    CHECK(sc.max_abs_curvature(x, sc.locate(x)) == Approx(1 / radius).epsilon(1e-12));
   }
 }
 
@@ -38,6 +40,7 @@ TEST_CASE("a void between four balls is a concave sphere", "[curvature]") {
   const PrincipalCurvatures pc = sc.curvature(x, cell);
   CHECK(pc.k1 == Approx(-1 / radius).epsilon(1e-12));
   CHECK(pc.k2 == Approx(-1 / radius).epsilon(1e-12));
+  CHECK(sc.max_abs_curvature(x, cell) == Approx(1 / radius).epsilon(1e-12));
 }
 
 TEST_CASE("a two-ball neck has the hyperboloid's principal curvatures", "[curvature]") {
@@ -66,6 +69,8 @@ TEST_CASE("a two-ball neck has the hyperboloid's principal curvatures", "[curvat
       const PrincipalCurvatures pc = sc.curvature(x, cell);
       CHECK(pc.k1 == Approx(parallel).epsilon(1e-10));
       CHECK(pc.k2 == Approx(meridian).epsilon(1e-10));
+      CHECK(sc.max_abs_curvature(x, cell) ==
+            Approx(std::max(std::abs(parallel), std::abs(meridian))).epsilon(1e-10));
       CHECK(std::abs(pc.d2.dot(Eigen::Vector3d::UnitX())) == Approx(1 / std::sqrt(1 + d1 * d1)).epsilon(1e-9));
     }
   }

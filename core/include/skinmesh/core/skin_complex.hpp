@@ -162,6 +162,9 @@ class SkinComplex {
 
   // Principal curvatures of the skin patch of `cell` at x (x on or near the skin).
   PrincipalCurvatures curvature(const Eigen::Vector3d& x, int cell) const;
+  // max(|k1|, |k2|) alone, what sizing asks for every triangle it judges:
+  // the 2x2 shape operator's eigenvalues in closed form, no directions.
+  double max_abs_curvature(const Eigen::Vector3d& x, int cell) const;
 
  private:
   friend struct SkinComplexBuilder;  // build_skin_complex.cpp
