@@ -147,8 +147,10 @@ static Violation worst_violation(const SkinComplex& sc, int c, const Eigen::Vect
     // bound is void (rounding noise); the cells beyond it bound nu_X instead.
     if (it->flat) continue;
     const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
+    const double gain = bk.power(v) - pi0;
+    if (!(gain < 0)) continue;  // v on X's side: no violation, and no square root to take (most cofaces)
     const double gap = (bk.center - b0.center).norm();
-    const double slack = (bk.power(v) - pi0) / (2 * std::max(gap, 1e-300));  // signed distance to the bisector
+    const double slack = gain / (2 * std::max(gap, 1e-300));  // signed distance to the bisector
     if (-slack > kPlaneTolerance && -slack > worst.amount) worst = {-slack, it->cell};
   }
   return worst;
@@ -388,12 +390,14 @@ static CellExit segment_exit(const SkinComplex& sc, int c, const Eigen::Vector3d
   }
   const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
   const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;
+  const double pi0 = b0.power(v0);
   for (auto it = sc.cofaces_begin(c); it != sc.cofaces_end(c); ++it) {
     if (it->flat) continue;  // void bound (see worst_violation)
     const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
     // pi_k(v) - pi_0(v) = -2 <v, z_k - z_0> + |z_k|^2 - w_k - |z_0|^2 + w_0
-    const Eigen::Vector3d dz = bk.center - b0.center;
-    consider(bk.power(v0) - b0.power(v0), -2.0 * v1.dot(dz), it->cell, it->beyond);
+    const double slope = -2.0 * v1.dot(bk.center - b0.center);
+    if (slope >= 0) continue;  // the segment does not approach this bisector (consider's own first test)
+    consider(bk.power(v0) - pi0, slope, it->cell, it->beyond);
   }
   return exit;
 }

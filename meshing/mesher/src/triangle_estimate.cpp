@@ -94,7 +94,7 @@ void add_cell(const SkinComplex& complex, int c, const std::vector<Eigen::Vector
     const Eigen::Vector3d x = cell.center + std::sqrt(alpha2) * u;
     if (complex.membership_violation(c, x) > 0) continue;
     const double area = solid_angle * alpha2 / std::abs(det_m * kappa);
-    const double k = complex.curvature(x, c).max_abs();
+    const double k = complex.max_abs_curvature(x, c);
     const double rho = k > 0 ? 1.0 / k : std::numeric_limits<double>::max();
     SkinAreaBin& bin = bins[bin_of(rho)];
     bin.area += area;
