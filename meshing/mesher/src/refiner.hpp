@@ -8,6 +8,8 @@
 
 #include "skinmesh/core/stopwatch.hpp"
 
+#include "skin_seeds.hpp"
+
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -261,7 +263,7 @@ class Refiner {
   std::optional<DualEdge> dual_edge(const FacetShape& shape, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                                     const Eigen::Vector3d& p2) const;
   // Seeds closer than spacing times the target edge length to a sample are left out.
-  void insert_seeds(double spacing);
+  void insert_seeds(const std::vector<SkinPoint>& seeds, double spacing);
   void insert_samples(const std::vector<SkinSample>& samples);
   Vertex_handle insert(const Eigen::Vector3d& p, int cell, Cell_handle hint);
   void stamp_star(Vertex_handle v);  // stamps the cells around a new vertex, into star_

@@ -232,7 +232,7 @@ Vertex_handle Refiner::insert(const Eigen::Vector3d& point, int cell, Cell_handl
   return v;
 }
 
-void Refiner::insert_seeds(double spacing) {
+void Refiner::insert_seeds(const std::vector<SkinPoint>& seeds, double spacing) {
   // Seeds closer than a quarter of the target edge length to a kept one are
   // dropped: a pair of nearly coincident critical points (common where a
   // critical point sits near a cell boundary) would otherwise force refinement
@@ -243,7 +243,6 @@ void Refiner::insert_seeds(double spacing) {
   // target length: every point of a meshed part of the skin lies within a
   // surface Delaunay ball radius (target / sqrt 3) of a sample, so only the
   // seeds of parts the samples miss are kept.
-  const auto seeds = detail::critical_point_seeds(complex_);
   Cell_handle hint;
   for (const auto& s : seeds) {
     const K::Point_3 p(s.point[0], s.point[1], s.point[2]);
@@ -1004,8 +1003,14 @@ void Refiner::refine_until_clean() {
 SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
   const auto start = Clock::now();
   report("seeding", Report::now);
+  // The seeds are found on the other cores while CGAL inserts the samples
+  // (serial): a morph frame's remesh waited 5 ms for them (pept -> 3al1).
+  std::vector<SkinPoint> seeds;
+  tbb::task_group seeding;
+  seeding.run([&] { seeds = critical_point_seeds(complex_); });
   if (samples) insert_samples(*samples);
-  insert_seeds(samples ? 1.0 : 0.25);
+  seeding.wait();
+  insert_seeds(seeds, samples ? 1.0 : 0.25);
   stats_.seconds_seeding = seconds_since(start);
   const auto refine_start = Clock::now();
   refine_until_clean();
