@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <tuple>
 #include <cmath>
 #include <string>
 #include <limits>
@@ -186,13 +187,7 @@ struct SkinComplexBuilder {
       c.balls = SkinComplex::ball_tuple(ids);
       cells.push_back(c);
     };
-    sc.vertex_cell_.assign(static_cast<size_t>(n), -1);
-    for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) {
-      sc.vertex_cell_[static_cast<size_t>(v->info())] = static_cast<int>(cells.size());
-      add({v->info(), -1, -1, -1}, 1);
-    }
-    for (int i = 0; i < n; ++i)
-      if (sc.vertex_cell_[static_cast<size_t>(i)] < 0) sc.hidden_.push_back(i);
+    for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) add({v->info(), -1, -1, -1}, 1);
     if (rt.dimension() >= 1)
       for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e)
         add({e->first->vertex(e->second)->info(), e->first->vertex(e->third)->info(), -1, -1}, 2);
@@ -205,6 +200,20 @@ struct SkinComplexBuilder {
     if (rt.dimension() == 3)
       for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c)
         add({c->vertex(0)->info(), c->vertex(1)->info(), c->vertex(2)->info(), c->vertex(3)->info()}, 4);
+    // Numbered by dimension and ball tuple, not in CGAL's order: its edge
+    // and facet iterators report each simplex from the cell with the
+    // smaller handle, i.e. by memory address, and the numbering then
+    // changed with the heap's layout (the same morph gave a different cell,
+    // and one vertex an ulp elsewhere, when its output path was one
+    // character longer). Walks start from and step through these numbers.
+    std::sort(cells.begin(), cells.end(), [](const MixedCell& a, const MixedCell& b) {
+      return std::tie(a.dim, a.balls) < std::tie(b.dim, b.balls);
+    });
+    sc.vertex_cell_.assign(static_cast<size_t>(n), -1);
+    for (size_t i = 0; i < cells.size() && cells[i].dim == 0; ++i)
+      sc.vertex_cell_[static_cast<size_t>(cells[i].balls[0])] = static_cast<int>(i);
+    for (int i = 0; i < n; ++i)
+      if (sc.vertex_cell_[static_cast<size_t>(i)] < 0) sc.hidden_.push_back(i);
     // The tuple -> cell lookup (find_cell).
     sc.cell_of_balls_.reserve(cells.size() * 2);
     for (size_t i = 0; i < cells.size(); ++i) sc.cell_of_balls_.emplace(cells[i].balls, static_cast<int>(i));
