@@ -2,6 +2,7 @@
 
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/morph/relaxation.hpp"
 #include "skinmesh/morph/transport.hpp"
 
 #include "local_repair.hpp"
@@ -233,6 +234,7 @@ const MorphFrame& Morph::advance_to(double t) {
   std::vector<char> drop = move_vertices(next, moved, stats);
   std::vector<char> failing;
   if (stats.lost == 0) {
+    if (options_.relaxation.passes > 0) relax_tangentially(next, moved, options_.relaxation);
     failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
     stats.bad_triangles = std::count(failing.begin(), failing.end(), 1);
   }

@@ -8,7 +8,11 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/morph.hpp"
+#include "skinmesh/morph/relaxation.hpp"
 #include "skinmesh/morph/transport.hpp"
+
+#include <tbb/task_arena.h>
 
 #include <catch2/catch.hpp>
 
@@ -148,4 +152,88 @@ TEST_CASE("transport reports the cells where a neck forms between two frames", "
   // The neck opens in one step of 1/100 and in no earlier one.
   CHECK(across > 0);
   CHECK(quiet == 0);
+}
+
+namespace {
+
+// The triangles of `mesh` failing the morph's frame criteria on `complex`
+// (the mesher's public criteria and the outward check, as the morph judges).
+long failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria) {
+  long failing = 0;
+  for (const auto& t : mesh.triangles) {
+    const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
+                                                 mesh.vertices[static_cast<size_t>(t[1])],
+                                                 mesh.vertices[static_cast<size_t>(t[2])]};
+    const auto r = restricted_triangle(complex, corners, criteria.tolerance, mesh.cells[static_cast<size_t>(t[0])]);
+    failing += !r || triangle_defect(complex, *r, criteria) != TriangleDefect::none || !faces_outward(complex, *r);
+  }
+  return failing;
+}
+
+// A frame of 2k39 model 1 -> 3 at t = 0.3 moved to 0.31 as the morph moves
+// it: transported in its cells, projected where it left them.
+struct TransportedFrame {
+  SurfaceMesh mesh;
+  SkinComplex to;
+  MorphOracle oracle;
+};
+
+TransportedFrame transported_2k39_frame() {
+  const auto source = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
+  const auto target = test::centred_model(test::data_file("2k39_3models.pdb"), 3);
+  const Morph morph = prepare_morph(source, target, 0.3);
+  TransportedFrame f{morph.frame().mesh,
+                     morph.complex().with_balls(interpolated_balls(source, target, morph.pairs(), 0.31)),
+                     MorphOracle(source, target, 0.5)};
+  for (size_t v = 0; v < f.mesh.vertices.size(); ++v) {
+    const TransportedPoint moved = transport(morph.complex(), f.to, f.mesh.cells[v], f.mesh.vertices[v]);
+    if (moved.status == TransportStatus::in_cell) {
+      f.mesh.vertices[v] = moved.point;
+    } else {
+      const Projection p = f.to.project(moved.status == TransportStatus::left_cell ? moved.point : f.mesh.vertices[v],
+                                        f.mesh.cells[v], 1e-14);
+      REQUIRE(p.converged);
+      f.mesh.vertices[v] = p.point;
+      f.mesh.cells[v] = p.cell;
+    }
+    f.mesh.normals[v] = f.to.evaluate(f.mesh.vertices[v], f.mesh.cells[v]).gradient.normalized();
+  }
+  return f;
+}
+
+}  // namespace
+
+// Transport is a similarity per cell; neighbouring cells scale differently
+// and shear the triangles between them. Relaxation along the skin must undo
+// much of that while every vertex stays exactly on the skin of B(t).
+TEST_CASE("tangential relaxation keeps a transported frame on the skin and mends transport's shear", "[morph]") {
+  TransportedFrame f = transported_2k39_frame();
+  const MeshingOptions criteria = MorphOptions().frames;
+  const long before = failing_triangles(f.to, f.mesh, criteria);
+  const SurfaceMesh transported = f.mesh;
+  relax_tangentially(f.to, f.mesh, RelaxationOptions{});
+  const long after = failing_triangles(f.to, f.mesh, criteria);
+  INFO("failing triangles: " << before << " transported, " << after << " relaxed");
+  CHECK(before > 0);
+  CHECK(2 * after <= before);
+  double worst = 0, moved = 0;
+  for (size_t v = 0; v < f.mesh.vertices.size(); ++v) {
+    const MorphOracleResult o = f.oracle.evaluate(f.mesh.vertices[v], 0.31);
+    REQUIRE(o.certified);
+    worst = std::max(worst, o.distance());
+    CHECK(f.to.membership_violation(f.mesh.cells[v], f.mesh.vertices[v]) <= 1e-9);
+    moved = std::max(moved, (f.mesh.vertices[v] - transported.vertices[v]).norm());
+  }
+  CHECK(worst <= 1e-8);
+  CHECK(moved > 1e-3);  // it did move vertices
+  CHECK(f.mesh.triangles == transported.triangles);
+}
+
+TEST_CASE("tangential relaxation gives the same points with one thread as with several", "[morph]") {
+  TransportedFrame f = transported_2k39_frame();
+  SurfaceMesh one = f.mesh, many = f.mesh;
+  tbb::task_arena(1).execute([&] { relax_tangentially(f.to, one, RelaxationOptions{}); });
+  relax_tangentially(f.to, many, RelaxationOptions{});
+  CHECK(one.vertices == many.vertices);
+  CHECK(one.cells == many.cells);
 }

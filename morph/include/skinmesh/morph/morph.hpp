@@ -25,6 +25,7 @@
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/morph/events.hpp"
+#include "skinmesh/morph/relaxation.hpp"
 
 #include <array>
 #include <vector>
@@ -70,6 +71,9 @@ struct MorphOptions {
   // (the earlier defaults) 0.169 s, 20,361, 99 of 99; 0.85 alone 0.156 s,
   // 18,649, 99; neither 0.127 s, 15,070, 99. 2k39 model 1 -> 3: 0.069 s,
   // 69; 0.068 s, 74; 0.054 s, 86.
+  // Tangential relaxation after transport, before the triangles are judged
+  // (relaxation.hpp; passes = 0: none).
+  RelaxationOptions relaxation;
   double repair_angle_margin = 0.0;  // degrees
   double repair_size_margin = 1.0;
   double first_size_margin = 0.85;
