@@ -321,7 +321,7 @@ void print_progress(size_t done, size_t total, const FrameStats& s, long repairs
 json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& morph, const std::vector<double>& t,
                 const MorphOptions& options) {
   json events = json::array();
-  for (const TopologyEvent& e : morph.events()) events.push_back({{"t", e.t}, {"cell", e.cell}});
+  for (const TopologyEvent& e : morph.events()) events.push_back({{"t", e.t}, {"cell", e.cell}, {"dim", e.dim}, {"euler_change", e.euler_change}});
   return {{"source", o.source},
           {"target", o.target},
           {"source_model", o.source_model},

@@ -36,6 +36,11 @@ std::vector<CellSize> cell_sizes(const SkinComplex& middle, const std::vector<Ba
 struct TopologyEvent {
   double t = 0;   // in (0,1)
   int cell = -1;  // the cell of `middle` whose size changes sign
+  // Filled by critical_events: the cell's dimension (the index of the
+  // critical point) and the change of the skin's Euler characteristic as
+  // the morph passes t (+-2; 0 where the size only touches zero).
+  int dim = 0;
+  int euler_change = 0;
 };
 
 // Every sign change of an overlay cell's size curve inside (0,1), by time. A
@@ -46,7 +51,10 @@ std::vector<TopologyEvent> topology_events(const std::vector<CellSize>& sizes);
 // cell vanishes its quadric is a cone with apex z(t), and the skin changes
 // there only if the apex lies in the cell's own mixed cell (a critical point
 // of the skin, Edelsbrunner 1999), i.e. if the morph oracle's minimiser at
-// (z(t), t) is supported by exactly the cell's pairs. `middle` and `pairs`
+// (z(t), t) is supported by exactly the cell's source balls X and target
+// balls Y. An overlay cell (X, Y) that is not a simplex (a prism, a
+// parallelogram) is triangulated into simplices with one centre and one
+// size curve: it is one critical point, reported once. `middle` and `pairs`
 // as for cell_sizes.
 std::vector<TopologyEvent> critical_events(const std::vector<TopologyEvent>& events,
                                            const std::vector<CellSize>& sizes, const SkinComplex& middle,
