@@ -374,18 +374,42 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
 
 }  // namespace
 
+namespace {
+
+// The triangles with a corner near a topology change.
+void mark_near_changes(const SurfaceMesh& mesh, const std::vector<TopologyChange>& changes,
+                       std::vector<char>& region) {
+  for (size_t f = 0; f < mesh.triangles.size(); ++f)
+    for (const TopologyChange& c : changes)
+      for (int v : mesh.triangles[f])
+        if ((mesh.vertices[static_cast<size_t>(v)] - c.point).squaredNorm() <= c.radius * c.radius) region[f] = 1;
+}
+
+// Without a change the patch keeps the topology (a patch that grew a second
+// layer or closed a piece off shows up here); with changes, the Euler
+// characteristic must change by what the critical events say (Morse theory,
+// exact: events.hpp), and the components by no more than one a change.
+bool topology_as_expected(const SurfaceMesh& before, const SurfaceMesh& after, const LocalRepairOptions& options) {
+  const auto [components_before, euler_before] = components_and_euler(before);
+  const auto [components_after, euler_after] = components_and_euler(after);
+  if (euler_after != euler_before + options.euler_change) return false;
+  return std::abs(components_after - components_before) <= static_cast<long>(options.changes.size());
+}
+
+}  // namespace
+
 LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
   LocalRepair out;
   const VertexStars stars(mesh);
-  std::vector<char> region = grow_region(mesh, stars, failing, options.rings);
+  std::vector<char> region = failing;
+  mark_near_changes(mesh, options.changes, region);
+  region = grow_region(mesh, stars, std::move(region), options.rings);
   for (int attempt = 0; attempt < options.attempts; ++attempt) {
     Attempt a = try_patch(complex, mesh, stars, region, repair, accept, options.crowded_below);
     if (a.ok) {
-      // Without a topology event the patch keeps the topology: a patch that
-      // grew a second layer or closed a piece off shows up here.
-      if (components_and_euler(a.merged) != components_and_euler(mesh)) return out;
+      if (!topology_as_expected(mesh, a.merged, options)) return out;
       out.patch_triangles = std::count(region.begin(), region.end(), 1);
       compact(a.merged, mesh.vertices.size(), out);
       out.repairs = a.repairs;

@@ -24,14 +24,27 @@ struct LocalRepair {
   long patch_triangles = 0;  // triangles replaced
 };
 
+// A place where the skin's topology changes between the frames (a critical
+// event's apex at the new frame): the triangles with a corner within
+// `radius` of `point` join the patch.
+struct TopologyChange {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double radius = 0;  // Angstrom
+};
+
 struct LocalRepairOptions {
   int rings = 2;               // rings of triangles around the failing ones
   int attempts = 4;            // the patch grown around the seam's faults, at most this many times
   double crowded_below = 0.4;  // interior vertices this close (times the target length) are removed
+  // Topology changes the patch must make (none: the topology must stay), and
+  // the change of the Euler characteristic they add up to (the critical
+  // events', events.hpp). The components may change by at most one a change.
+  std::vector<TopologyChange> changes;
+  long euler_change = 0;
 };
 
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on
-// the skin of `complex`. The patch is refined to `repair` (stricter, for
+// the skin of `complex` (may be all zero when options.changes is not empty). The patch is refined to `repair` (stricter, for
 // room before the next failure); its new triangles must meet `accept`.
 LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,

@@ -11,11 +11,31 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace skinmesh {
 
 namespace {
+
+// The critical events in (from, to] as places where the local repair must
+// change the topology, with the change of the Euler characteristic they add
+// up to. False when one of them makes or removes a component or a void
+// (dimension 0 or 3): a birth has no vertex to start from (the patch does
+// not seed) and a death loses its vertices, so that frame is remeshed whole.
+// The patch reaches 1 A plus twice the size of the neck at `to` from the
+// event's apex, past the vertices transport left around it.
+bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
+                          double to, detail::LocalRepairOptions& local) {
+  for (const TopologyEvent& e : events) {
+    if (!(e.t > from && e.t <= to)) continue;
+    if (e.dim == 0 || e.dim == 3) return false;
+    const CellSize& size = sizes[static_cast<size_t>(e.cell)];
+    local.changes.push_back({size.center(to), 1.0 + 2 * std::sqrt(std::abs(size.at(to)))});
+    local.euler_change += e.euler_change;
+  }
+  return true;
+}
 
 MeshingOptions with_size_margin(MeshingOptions o, double margin) {
   o.sizing.epsilon *= margin;
@@ -116,11 +136,15 @@ long Morph::mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::
   return marked;
 }
 
-// The failing triangles remeshed in patches (local_repair.hpp); false when
-// the seam does not hold (the caller remeshes the frame).
-bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing) {
+// The failing triangles, and those around the topology changes since the
+// current frame, remeshed in patches (local_repair.hpp); false when an event
+// needs the whole frame, the seam does not hold or the topology is not what
+// the events say (the caller remeshes the frame).
+bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
+                           double t) {
   detail::LocalRepairOptions local;
   local.crowded_below = options_.crowded_below;
+  if (!add_topology_changes(events_, sizes_, t_, t, local)) return false;
   detail::LocalRepair r =
       detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
   if (!r.ok) return false;
@@ -243,9 +267,9 @@ const MorphFrame& Morph::advance_to(double t) {
     frame_.mesh = std::move(moved);  // ids stay: every vertex survives
   } else {
     const auto repair_start = Clock::now();
-    const bool local = stats.events == 0 && stats.lost == 0 &&
+    const bool local = stats.lost == 0 &&
                        stats.bad_triangles <= options_.local_repair_share * static_cast<double>(failing.size());
-    if (!(local && repair_locally(next, moved, failing))) {
+    if (!(local && repair_locally(next, moved, failing, t))) {
       frame_.stats.crowded = mark_crowded(next, moved, drop);
       remesh_or_rebuild(next, moved, drop);
     }

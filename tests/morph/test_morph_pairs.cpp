@@ -71,6 +71,7 @@ void check_against_reference(const SurfaceMesh& mesh, const MeshQuality& q, cons
 struct FrameRecord {
   double t;
   long components, euler, cavities;
+  FrameStats stats;
 };
 
 // Advances through `times` (the first is the first frame) and checks every
@@ -121,7 +122,7 @@ std::vector<FrameRecord> check_frames(const std::vector<Ball>& source, const std
       }
       CHECK(found);
     }
-    records.push_back({t, q.components, q.euler, q.cavities});
+    records.push_back({t, q.components, q.euler, q.cavities, f.stats});
   }
   // The last frame at t = 1 is a static quality mesh of the target.
   if (times.back() == 1.0) {
@@ -321,4 +322,21 @@ TEST_CASE("critical events account for every change of the skin's Euler characte
     }
     CHECK(changes >= 5);  // the test sees topology change, not only a constant
   }
+}
+
+TEST_CASE("morph 2k39 model 1 -> 3: a neck that opens or pinches between frames is remeshed locally", "[morph][events]") {
+  // A critical event of dimension 1 or 2 between two frames is handled by
+  // the local repair, its patch reaching around the event's apex, and the
+  // patch is taken only when the Euler characteristic changes as the events
+  // say. Every frame checked as for the other pairs (the static mesher's
+  // components and Euler characteristic, the morph oracle, the grader).
+  std::vector<double> times;
+  for (int k = 46; k <= 56; ++k) times.push_back(k / 100.0);
+  const std::vector<FrameRecord> records =
+      check_frames(molecule_balls("2k39_3models.pdb", 1), molecule_balls("2k39_3models.pdb", 3), times,
+                   Reference::static_mesher);
+  long local_events = 0;
+  for (const FrameRecord& r : records)
+    local_events += r.stats.events > 0 && r.stats.patch_triangles > 0 && !r.stats.remeshed && !r.stats.full_rebuild;
+  CHECK(local_events >= 1);
 }

@@ -5,12 +5,15 @@
 // projected back onto the new skin; every triangle is then judged by the
 // mesher's own criteria (restricted_triangle, triangle_defect).
 //
-// Repair: the failing triangles of a frame, grown by a few rings, are
-// remeshed by restricted Delaunay refinement of their own vertices and
-// stitched back (local repair); the rest of the mesh is kept as transported.
-// A frame where that fails, a vertex is lost (its cell's size vanished and
-// no skin point is near), or a critical topology event lies since the last
-// frame, is remeshed as a whole from its own transported vertices
+// Repair: the failing triangles of a frame, and those around a neck that
+// opened or pinched since the last frame (a critical topology event of
+// dimension 1 or 2), grown by a few rings, are remeshed by restricted
+// Delaunay refinement of their own vertices and stitched back (local
+// repair), the Euler characteristic checked against the events'; the rest
+// of the mesh is kept as transported. A frame where that fails, a vertex is
+// lost (its cell's size vanished and no skin point is near), or a component
+// or void appears or vanishes since the last frame (an event of dimension 0
+// or 3), is remeshed as a whole from its own transported vertices
 // (remesh_skin): they are kept, those transport crowded together removed,
 // and restricted Delaunay refinement inserts points only where a triangle
 // fails, and seeds only on skin the vertices miss (a component born, a neck
@@ -136,7 +139,7 @@ class Morph {
   void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
-  bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing);
+  bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing, double t);
   long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
 
   void reseat(const SkinComplex& next, FrameStats& stats);
