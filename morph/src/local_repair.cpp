@@ -106,7 +106,10 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
 // region's triangles, about the diameter of a patch facet's surface
 // Delaunay ball.
 void add_nearby_context(const SurfaceMesh& mesh, const std::vector<char>& region, std::vector<signed char>& role) {
-  const double reach = 2 * longest_edge(mesh, region);
+  // A region of seeds alone (a newborn component) takes the mesh's longest edge.
+  double longest = longest_edge(mesh, region);
+  if (!(longest > 0)) longest = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
+  const double reach = 2 * longest;
   if (!(reach > 0)) return;
   auto cell_of = [&](const Eigen::Vector3d& p) -> Eigen::Vector3i { return (p / reach).array().floor().cast<int>(); };
   auto key = [](const Eigen::Vector3i& c) {  // 21 bits a coordinate
@@ -328,11 +331,14 @@ struct Attempt {
   std::vector<int> faults;
 };
 
+// `seeds_from`: the mesh's vertices from this index on are seeds on a newborn
+// component (no triangles yet), interior to the patch.
 Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
-                  const std::vector<char>& region, const MeshingOptions& repair, const MeshingOptions& accept,
-                  double crowded_below) {
+                  const std::vector<char>& region, size_t seeds_from, const MeshingOptions& repair,
+                  const MeshingOptions& accept, double crowded_below) {
   Attempt a;
   std::vector<signed char> role = vertex_roles(mesh, stars, region);
+  for (size_t v = seeds_from; v < role.size(); ++v) role[v] = static_cast<signed char>(PatchRole::interior);
   add_nearby_context(mesh, region, role);
   const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, crowded_below);
   std::vector<PatchRole> roles;
@@ -376,6 +382,33 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
 
 namespace {
 
+// The mesh with seed vertices (no triangles) on each component or void
+// born since the last frame: skin points projected from six points around
+// the new sphere's centre, at half its size, inside it, so that the
+// gradient leads out to the sphere. Seeds within 1e-6 A of another are
+// left out.
+SurfaceMesh with_birth_seeds(const SkinComplex& complex, const SurfaceMesh& mesh,
+                             const std::vector<TopologyChange>& changes) {
+  SurfaceMesh seeded = mesh;
+  for (const TopologyChange& c : changes) {
+    if (!c.birth) continue;
+    for (int k = 0; k < 6; ++k) {
+      Eigen::Vector3d from = c.point;
+      from[k / 2] += (k % 2 ? -0.5 : 0.5) * c.size;
+      const Projection p = complex.project(from, c.cell, 1e-14);
+      if (!p.converged) continue;
+      const bool known = std::any_of(seeded.vertices.begin() + static_cast<long>(mesh.vertices.size()),
+                                     seeded.vertices.end(),
+                                     [&](const Eigen::Vector3d& q) { return (q - p.point).norm() < 1e-6; });
+      if (known) continue;
+      seeded.vertices.push_back(p.point);
+      seeded.cells.push_back(p.cell);
+      seeded.normals.push_back(complex.evaluate(p.point, p.cell).gradient.normalized());
+    }
+  }
+  return seeded;
+}
+
 // The triangles with a corner near a topology change.
 void mark_near_changes(const SurfaceMesh& mesh, const std::vector<TopologyChange>& changes,
                        std::vector<char>& region) {
@@ -398,20 +431,21 @@ bool topology_as_expected(const SurfaceMesh& before, const SurfaceMesh& after, c
 
 }  // namespace
 
-LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
   LocalRepair out;
+  const SurfaceMesh mesh = with_birth_seeds(complex, given, options.changes);
   const VertexStars stars(mesh);
   std::vector<char> region = failing;
   mark_near_changes(mesh, options.changes, region);
   region = grow_region(mesh, stars, std::move(region), options.rings);
   for (int attempt = 0; attempt < options.attempts; ++attempt) {
-    Attempt a = try_patch(complex, mesh, stars, region, repair, accept, options.crowded_below);
+    Attempt a = try_patch(complex, mesh, stars, region, given.vertices.size(), repair, accept, options.crowded_below);
     if (a.ok) {
-      if (!topology_as_expected(mesh, a.merged, options)) return out;
+      if (!topology_as_expected(given, a.merged, options)) return out;
       out.patch_triangles = std::count(region.begin(), region.end(), 1);
-      compact(a.merged, mesh.vertices.size(), out);
+      compact(a.merged, given.vertices.size(), out);
       out.repairs = a.repairs;
       out.ok = true;
       return out;

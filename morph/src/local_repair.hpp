@@ -30,6 +30,13 @@ struct LocalRepair {
 struct TopologyChange {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double radius = 0;  // Angstrom
+  // A component or a void born there (no vertex lies on it yet): the patch
+  // is seeded with skin points found from around `point`, the centre of
+  // the new sphere, at half of `size` (sqrt|R2|, about its radius), in
+  // `cell` of the complex.
+  bool birth = false;
+  double size = 0;  // Angstrom
+  int cell = -1;
 };
 
 struct LocalRepairOptions {

@@ -20,18 +20,26 @@ namespace {
 
 // The critical events in (from, to] as places where the local repair must
 // change the topology, with the change of the Euler characteristic they add
-// up to. False when one of them makes or removes a component or a void
-// (dimension 0 or 3): a birth has no vertex to start from (the patch does
-// not seed) and a death loses its vertices, so that frame is remeshed whole.
-// The patch reaches 1 A plus twice the size of the neck at `to` from the
-// event's apex, past the vertices transport left around it.
+// up to. A component or a void born (dimension 0 or 3, the Euler
+// characteristic up by 2) is seeded around its centre. False when one
+// vanishes (down by 2): its vertices are lost, and the frame is remeshed
+// whole. The patch reaches 1 A plus twice the feature's size at `to` from
+// the event's apex, past the vertices transport left around it.
 bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
                           double to, detail::LocalRepairOptions& local) {
   for (const TopologyEvent& e : events) {
     if (!(e.t > from && e.t <= to)) continue;
-    if (e.dim == 0 || e.dim == 3) return false;
+    const bool sphere = e.dim == 0 || e.dim == 3;
+    if (sphere && e.euler_change < 0) return false;
     const CellSize& size = sizes[static_cast<size_t>(e.cell)];
-    local.changes.push_back({size.center(to), 1.0 + 2 * std::sqrt(std::abs(size.at(to)))});
+    const double feature = std::sqrt(std::abs(size.at(to)));
+    detail::TopologyChange change;
+    change.point = size.center(to);
+    change.radius = 1.0 + 2 * feature;
+    change.birth = sphere && e.euler_change > 0;
+    change.size = feature;
+    change.cell = e.cell;
+    local.changes.push_back(change);
     local.euler_change += e.euler_change;
   }
   return true;

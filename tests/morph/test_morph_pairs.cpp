@@ -340,3 +340,26 @@ TEST_CASE("morph 2k39 model 1 -> 3: a neck that opens or pinches between frames 
     local_events += r.stats.events > 0 && r.stats.patch_triangles > 0 && !r.stats.remeshed && !r.stats.full_rebuild;
   CHECK(local_events >= 1);
 }
+
+TEST_CASE("synthetic events: a component born far from the rest is meshed locally", "[morph][events]") {
+  // A large ball, and a small one that appears 12 A away near the end: the
+  // pair's ball has negative weight until t = 0.965. The large sphere moves
+  // exactly (one cell), so the step holding the birth has nothing else to
+  // repair; the patch is seeded on the new sphere and must add a component
+  // (Euler characteristic up by 2). Every frame checked against CGAL's
+  // certified skin mesh of B(t).
+  const std::vector<Ball> source{lone(0, 0, 0, 3.0)};
+  const std::vector<Ball> target{lone(0, 0, 0, 3.0), lone(12, 0, 0, 1.5)};
+  const std::vector<double> times{0.94, 0.95, 0.96, 0.97, 0.98, 0.99};
+  const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin);
+  CHECK(records.front().components == 1);
+  CHECK(records.back().components == 2);
+  long local_births = 0;
+  for (const FrameRecord& r : records) {
+    INFO("t = " << r.t << ": events " << r.stats.events << ", remeshed " << r.stats.remeshed << ", inserted "
+                << r.stats.inserted);
+    local_births += r.stats.events > 0 && r.stats.repaired && !r.stats.remeshed && !r.stats.full_rebuild;
+  }
+  CHECK(local_births == 1);
+  check_events_cover_changes(prepare_morph(source, target, 0.0), records);
+}
