@@ -7,13 +7,14 @@
 //
 // Repair: the failing triangles of a frame, and those around a neck that
 // opened or pinched since the last frame (a critical topology event of
-// dimension 1 or 2), grown by a few rings, are remeshed by restricted
-// Delaunay refinement of their own vertices and stitched back (local
-// repair), the Euler characteristic checked against the events'; the rest
-// of the mesh is kept as transported. A frame where that fails, a vertex is
-// lost (its cell's size vanished and no skin point is near), or a component
-// or void appears or vanishes since the last frame (an event of dimension 0
-// or 3), is remeshed as a whole from its own transported vertices
+// dimension 1 or 2), grown by a ring, are remeshed by restricted Delaunay
+// refinement of their own vertices, with seeds on any component or void
+// born since (dimension 0 or 3), and stitched back (local repair), the
+// Euler characteristic checked against the events'; the rest of the mesh
+// is kept as transported. A frame where that fails, a vertex is lost (its
+// cell's size vanished and no skin point is near), or a component or void
+// vanishes since the last frame, is remeshed as a whole from its own
+// transported vertices
 // (remesh_skin): they are kept, those transport crowded together removed,
 // and restricted Delaunay refinement inserts points only where a triangle
 // fails, and seeds only on skin the vertices miss (a component born, a neck
