@@ -56,8 +56,9 @@ struct LocalRepairOptions {
 };
 
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on
-// the skin of `complex` (may be all zero when options.changes is not empty). The patch is refined to `repair` (stricter, for
-// room before the next failure); its new triangles must meet `accept`.
+// the skin of `complex` (all zero is fine when options.changes is not
+// empty). The patch is refined to `repair` (stricter, for room before the
+// next failure); its new triangles must meet `accept`.
 LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options);
