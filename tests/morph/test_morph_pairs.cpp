@@ -295,7 +295,9 @@ TEST_CASE("critical events account for every change of the skin's Euler characte
       {molecule_balls("pept.pdb"), molecule_balls("3al1.pdb")}};
   GradeOptions topology_only;
   topology_only.self_intersections = SelfIntersectionCheck::skip;
-  for (const auto& [source, target] : morphs) {
+  for (const auto& sides : morphs) {
+    const std::vector<Ball>& source = sides.first;  // not a structured binding: lambdas capture it (C++17)
+    const std::vector<Ball>& target = sides.second;
     const std::vector<BallPair> pairs = live_pairs(source, target);
     const Morph morph = prepare_morph(source, target, 0.5);
     auto euler_at = [&](double t) {
