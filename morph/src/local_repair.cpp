@@ -435,7 +435,12 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
   LocalRepair out;
-  const SurfaceMesh mesh = with_birth_seeds(complex, given, options.changes);
+  // The frame is copied only when seeds are to be added to it.
+  const bool births = std::any_of(options.changes.begin(), options.changes.end(),
+                                  [](const TopologyChange& c) { return c.birth; });
+  SurfaceMesh seeded;
+  if (births) seeded = with_birth_seeds(complex, given, options.changes);
+  const SurfaceMesh& mesh = births ? seeded : given;
   const VertexStars stars(mesh);
   std::vector<char> region = failing;
   mark_near_changes(mesh, options.changes, region);
