@@ -202,6 +202,7 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"inserted", s.inserted},
           {"removed", s.removed},
           {"repairs", s.repairs},
+          {"edits", {{"split", s.split}, {"flipped", s.flipped}, {"contracted", s.contracted}}},
           {"bad_triangles_after_transport", s.bad_triangles},
           {"repaired", s.repaired},
           {"full_rebuild", s.full_rebuild},

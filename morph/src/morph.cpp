@@ -6,6 +6,7 @@
 #include "skinmesh/morph/transport.hpp"
 
 #include "local_repair.hpp"
+#include "surgery.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -149,10 +150,7 @@ long Morph::mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::
 // needs the whole frame, the seam does not hold or the topology is not what
 // the events say (the caller remeshes the frame).
 bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
-                           double t) {
-  detail::LocalRepairOptions local;
-  local.crowded_below = options_.crowded_below;
-  if (!add_topology_changes(events_, sizes_, t_, t, local)) return false;
+                           const detail::LocalRepairOptions& local) {
   detail::LocalRepair r =
       detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
   if (!r.ok) return false;
@@ -170,6 +168,23 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
   frame_.mesh = std::move(r.mesh);
   frame_.ids = std::move(ids);
   return true;
+}
+
+// The failing triangles mended by edits of the mesh (surgery.hpp); `moved`,
+// `failing` and `drop` become the edited mesh's, and the frame's ids follow
+// its vertices. Returns how many triangles still fail.
+long Morph::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+                          std::vector<char>& drop, EditCounts& counts) {
+  detail::Surgery s = detail::mend_by_edits(next, moved, failing, options_.frames);
+  std::vector<long> ids(s.origin.size());
+  for (size_t v = 0; v < ids.size(); ++v)
+    ids[v] = s.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(s.origin[v])] : next_id_++;
+  frame_.ids = std::move(ids);
+  moved = std::move(s.mesh);
+  failing = std::move(s.failing);
+  drop.assign(moved.vertices.size(), 0);
+  counts = {s.splits, s.flips, s.contractions};
+  return s.left;
 }
 
 // Remeshes the frame from the transported vertices not dropped; false when
@@ -275,12 +290,32 @@ const MorphFrame& Morph::advance_to(double t) {
     frame_.mesh = std::move(moved);  // ids stay: every vertex survives
   } else {
     const auto repair_start = Clock::now();
-    const bool local = stats.lost == 0 &&
-                       stats.bad_triangles <= options_.local_repair_share * static_cast<double>(failing.size());
-    if (!(local && repair_locally(next, moved, failing, t))) {
-      frame_.stats.crowded = mark_crowded(next, moved, drop);
-      remesh_or_rebuild(next, moved, drop);
+    const long first_new_id = next_id_, before = static_cast<long>(frame_.ids.size());
+    // Edits and local repair are for frames without lost vertices or a
+    // vanishing component or void; the others are remeshed whole.
+    detail::LocalRepairOptions local;
+    local.crowded_below = options_.crowded_below;
+    const bool mendable = stats.lost == 0 && add_topology_changes(events_, sizes_, t_, t, local);
+    long left = stats.bad_triangles;
+    EditCounts edited;
+    if (mendable && left > 0 && options_.edits) left = mend_by_edits(next, moved, failing, drop, edited);
+    if (mendable && local.changes.empty() && left == 0) {
+      frame_.mesh = std::move(moved);
+      frame_.stats.repaired = true;
+    } else {
+      const bool small = left <= options_.local_repair_share * static_cast<double>(failing.size());
+      if (!(mendable && small && repair_locally(next, moved, failing, local))) {
+        frame_.stats.crowded = mark_crowded(next, moved, drop);
+        remesh_or_rebuild(next, moved, drop);
+      }
     }
+    frame_.stats.split = edited.split;
+    frame_.stats.flipped = edited.flipped;
+    frame_.stats.contracted = edited.contracted;
+    // Counted by ids, as vertices an edit inserted may be gone again after
+    // the repair that followed.
+    frame_.stats.inserted = std::count_if(frame_.ids.begin(), frame_.ids.end(), [&](long id) { return id >= first_new_id; });
+    frame_.stats.removed = before - (static_cast<long>(frame_.ids.size()) - frame_.stats.inserted);
     frame_.stats.seconds_repair = seconds_since(repair_start);
   }
   std::swap(current_, spare_);  // a copy of the complex was 1% of a frame (perf, pept -> 3al1)

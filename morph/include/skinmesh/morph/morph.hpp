@@ -36,6 +36,10 @@
 
 namespace skinmesh {
 
+namespace detail {
+struct LocalRepairOptions;  // local_repair.hpp (private to morph/)
+}  // namespace detail
+
 struct MorphOptions {
   double shrink = 0.5;      // s in (0,1)
   MeshingOptions first;     // the mesh of the first frame (default: the mesher's 30 degrees)
@@ -61,6 +65,11 @@ struct MorphOptions {
   // model 1 -> 3 and pept -> 3al1, 30 frames: with 3-4% failing, local
   // repair took 0.28 and 0.71 s a frame against 0.14 and 0.60 s). 0: never.
   double local_repair_share = 0.01;
+  // Failing triangles are first mended by edits of the mesh: an edge split
+  // at a new skin point with Delaunay flips around it, a flip, or the
+  // contraction of a short edge (docs/morph.md, "Mending by edits"); what
+  // is left goes to the local repair or the frame's remesh. false: none.
+  bool edits = true;
   // Repairs (local and whole-frame) may refine to stricter criteria than
   // frames are accepted at, so that a repaired triangle has room to move
   // before it fails again: the angle bound raised by the angle margin (at
@@ -100,6 +109,7 @@ struct FrameStats {
   long inserted = 0;           // new vertices (refinement and seeds)
   long removed = 0;            // vertices of the previous frame not in this one
   long repairs = 0;            // refinement insertions, each at a failing triangle
+  long split = 0, flipped = 0, contracted = 0;  // edits that mended failing triangles
   bool full_rebuild = false;   // the frame was meshed from scratch (repair failed)
   double seconds = 0;          // the whole frame
   double seconds_repair = 0;   // of which remeshing (or rebuilding)
@@ -139,8 +149,14 @@ class Morph {
   void rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t);
   void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
+  struct EditCounts {
+    long split = 0, flipped = 0, contracted = 0;
+  };
+  long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+                     std::vector<char>& drop, EditCounts& counts);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
-  bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing, double t);
+  bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
+                      const detail::LocalRepairOptions& local);
   long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
 
   void reseat(const SkinComplex& next, FrameStats& stats);

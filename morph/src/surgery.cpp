@@ -1,0 +1,402 @@
+#include "surgery.hpp"
+
+#include <Eigen/Geometry>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <unordered_map>
+
+namespace skinmesh::detail {
+namespace {
+
+using Triangle = std::array<int, 3>;
+
+uint64_t edge_key(int from, int to) {
+  return (uint64_t{static_cast<uint32_t>(from)} << 32) | static_cast<uint32_t>(to);
+}
+
+enum class Verdict { pass, size, shape, inward, other };
+
+double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d u = (a - apex).normalized(), w = (b - apex).normalized();
+  return std::acos(std::clamp(u.dot(w), -1.0, 1.0));
+}
+
+// The mesh with its directed edges indexed (each directed edge lies in one
+// triangle of a closed oriented manifold), edited in place.
+class Editor {
+ public:
+  Editor(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& accept,
+         const SurgeryOptions& options)
+      : complex_(complex), mesh_(mesh), accept_(accept), options_(options), vertices_before_(mesh.vertices.size()) {
+    if (mesh_.normals.size() != mesh_.vertices.size()) {
+      mesh_.normals.resize(mesh_.vertices.size());
+      for (size_t v = 0; v < mesh_.vertices.size(); ++v)
+        mesh_.normals[v] = complex_.evaluate(mesh_.vertices[v], mesh_.cells[v]).gradient.normalized();
+    }
+    alive_.assign(mesh_.triangles.size(), 1);
+    corner_face_.assign(mesh_.vertices.size(), -1);
+    edges_.reserve(mesh_.triangles.size() * 3);
+    for (int f = 0; f < static_cast<int>(mesh_.triangles.size()); ++f) attach(f);
+  }
+
+  Surgery run(const std::vector<char>& failing);
+
+ private:
+  const Triangle& tri(int f) const { return mesh_.triangles[static_cast<size_t>(f)]; }
+  const Eigen::Vector3d& at(int v) const { return mesh_.vertices[static_cast<size_t>(v)]; }
+  int face_of(int from, int to) const {
+    const auto it = edges_.find(edge_key(from, to));
+    return it == edges_.end() ? -1 : it->second;
+  }
+  int third(int f, int a, int b) const {
+    for (int v : tri(f))
+      if (v != a && v != b) return v;
+    return -1;
+  }
+  void attach(int f) {
+    const Triangle& t = tri(f);
+    for (size_t k = 0; k < 3; ++k) {
+      edges_[edge_key(t[k], t[(k + 1) % 3])] = f;
+      corner_face_[static_cast<size_t>(t[k])] = f;
+    }
+  }
+  void detach(int f) {
+    const Triangle& t = tri(f);
+    for (size_t k = 0; k < 3; ++k) edges_.erase(edge_key(t[k], t[(k + 1) % 3]));
+  }
+  int add_face(const Triangle& t) {
+    mesh_.triangles.push_back(t);
+    alive_.push_back(1);
+    return static_cast<int>(mesh_.triangles.size()) - 1;
+  }
+  // Whether triangle (a, b, c) turns the way the skin's normals at its corners point.
+  bool faces_out(const Triangle& t) const {
+    const Eigen::Vector3d n = (at(t[1]) - at(t[0])).cross(at(t[2]) - at(t[0]));
+    for (int v : t)
+      if (!(n.dot(mesh_.normals[static_cast<size_t>(v)]) > 0)) return false;
+    return true;
+  }
+  // The vertices around v, in order (the corner after v in each triangle).
+  std::vector<int> ring(int v) const;
+
+  Verdict judge(int f) const;
+  bool should_flip(int a, int b) const;
+  bool flip(int a, int b, std::vector<int>& touched);
+  void legalize(int apex, std::vector<std::pair<int, int>> link, std::vector<int>& touched);
+  bool try_flip(int f, std::vector<int>& touched);
+  bool try_split(int f, std::vector<int>& touched);
+  bool try_contract(int f, std::vector<int>& touched);
+  bool contract(int gone, int kept, std::vector<int>& touched);
+  void thin_crowded(std::unordered_map<int, int>& seen);
+
+  const SkinComplex& complex_;
+  SurfaceMesh mesh_;
+  const MeshingOptions& accept_;
+  SurgeryOptions options_;
+  std::vector<char> alive_;
+  std::vector<int> corner_face_;  // per vertex: a triangle it is a corner of (-1: gone)
+  std::unordered_map<uint64_t, int> edges_;
+  size_t vertices_before_;
+  long splits_ = 0, flips_ = 0, contractions_ = 0;
+};
+
+std::vector<int> Editor::ring(int v) const {
+  std::vector<int> out;
+  const int start = corner_face_[static_cast<size_t>(v)];
+  int f = start;
+  do {
+    const Triangle& t = tri(f);
+    const size_t k = static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin());
+    out.push_back(t[(k + 1) % 3]);
+    f = face_of(v, t[(k + 2) % 3]);  // across the edge into v
+    if (f < 0 || out.size() > 64) return {};
+  } while (f != start);
+  return out;
+}
+
+// The frame's criteria, as detail::triangle_passes applies them, with the
+// kind of failure: size and distance are mended by a split, shape first by
+// a contraction or a flip.
+Verdict Editor::judge(int f) const {
+  const Triangle& t = tri(f);
+  const std::array<Eigen::Vector3d, 3> corners{at(t[0]), at(t[1]), at(t[2])};
+  const auto restricted = restricted_triangle(complex_, corners, accept_.tolerance, mesh_.cells[static_cast<size_t>(t[0])]);
+  if (!restricted) return Verdict::other;
+  switch (triangle_defect(complex_, *restricted, accept_)) {
+    case TriangleDefect::none: return faces_outward(complex_, *restricted) ? Verdict::pass : Verdict::inward;
+    case TriangleDefect::size:
+    case TriangleDefect::distance: return Verdict::size;
+    case TriangleDefect::shape: return Verdict::shape;
+    default: return Verdict::other;
+  }
+}
+
+// Edge a -> b is not locally Delaunay: the angles opposite it add up to more
+// than pi (Lawson's flip criterion, on the mesh's own triangles).
+bool Editor::should_flip(int a, int b) const {
+  const int f = face_of(a, b), g = face_of(b, a);
+  if (f < 0 || g < 0) return false;
+  const int c = third(f, a, b), d = third(g, a, b);
+  return angle_at(at(c), at(a), at(b)) + angle_at(at(d), at(a), at(b)) > M_PI + 1e-12;
+}
+
+// Edge a -> b (in triangle (a, b, c); (b, a, d) across it) becomes c - d:
+// triangles (a, d, c) and (d, b, c), when both turn with the skin's normals
+// and c - d is not an edge yet.
+bool Editor::flip(int a, int b, std::vector<int>& touched) {
+  const int f = face_of(a, b), g = face_of(b, a);
+  if (f < 0 || g < 0) return false;
+  const int c = third(f, a, b), d = third(g, a, b);
+  if (c == d || face_of(c, d) >= 0 || face_of(d, c) >= 0) return false;
+  const Triangle t1{a, d, c}, t2{d, b, c};
+  if (!faces_out(t1) || !faces_out(t2)) return false;
+  detach(f);
+  detach(g);
+  mesh_.triangles[static_cast<size_t>(f)] = t1;
+  mesh_.triangles[static_cast<size_t>(g)] = t2;
+  attach(f);
+  attach(g);
+  corner_face_[static_cast<size_t>(a)] = f;
+  corner_face_[static_cast<size_t>(b)] = g;
+  touched.push_back(f);
+  touched.push_back(g);
+  ++flips_;
+  return true;
+}
+
+// Lawson's flips around a new vertex: each link edge (x -> y in the
+// triangle (x, y, apex)) that is not locally Delaunay is flipped, and the
+// two edges it uncovers are checked in turn.
+void Editor::legalize(int apex, std::vector<std::pair<int, int>> link, std::vector<int>& touched) {
+  int steps = 0;
+  while (!link.empty() && steps++ < 64) {
+    const auto [x, y] = link.back();
+    link.pop_back();
+    const int f = face_of(x, y);
+    if (f < 0 || third(f, x, y) != apex || !should_flip(x, y)) continue;
+    const int q = third(face_of(y, x), x, y);
+    if (!flip(x, y, touched)) continue;
+    link.emplace_back(x, q);  // now in (x, q, apex)
+    link.emplace_back(q, y);  // now in (q, y, apex)
+  }
+}
+
+bool Editor::try_flip(int f, std::vector<int>& touched) {
+  const Triangle& t = tri(f);
+  size_t longest = 0;
+  double best = -1;
+  for (size_t k = 0; k < 3; ++k) {
+    const double len = (at(t[(k + 1) % 3]) - at(t[k])).squaredNorm();
+    if (len > best) best = len, longest = k;
+  }
+  const int a = t[longest], b = t[(longest + 1) % 3];
+  return should_flip(a, b) && flip(a, b, touched);
+}
+
+// The longest edge split at the skin point nearest its midpoint (the
+// projection, exact on the skin), then Lawson's flips around it.
+bool Editor::try_split(int f, std::vector<int>& touched) {
+  const Triangle t = tri(f);
+  size_t longest = 0;
+  double best = -1;
+  for (size_t k = 0; k < 3; ++k) {
+    const double len = (at(t[(k + 1) % 3]) - at(t[k])).squaredNorm();
+    if (len > best) best = len, longest = k;
+  }
+  const int a = t[longest], b = t[(longest + 1) % 3], c = t[(longest + 2) % 3];
+  const int g = face_of(b, a);
+  if (g < 0) return false;
+  const int d = third(g, a, b);
+  const Eigen::Vector3d mid = 0.5 * (at(a) + at(b));
+  const Projection p = complex_.project(mid, mesh_.cells[static_cast<size_t>(a)], 1e-14);
+  // Farther than half the edge, the projection went to another sheet.
+  if (!p.converged || (p.point - mid).norm() > 0.5 * std::sqrt(best)) return false;
+  const int m = static_cast<int>(mesh_.vertices.size());
+  mesh_.vertices.push_back(p.point);
+  mesh_.cells.push_back(p.cell);
+  mesh_.normals.push_back(complex_.evaluate(p.point, p.cell).gradient.normalized());
+  corner_face_.push_back(-1);
+  const std::array<Triangle, 4> made{Triangle{a, m, c}, Triangle{m, b, c}, Triangle{b, m, d}, Triangle{m, a, d}};
+  if (!std::all_of(made.begin(), made.end(), [&](const Triangle& n) { return faces_out(n); })) {
+    mesh_.vertices.pop_back();
+    mesh_.cells.pop_back();
+    mesh_.normals.pop_back();
+    corner_face_.pop_back();
+    return false;
+  }
+  detach(f);
+  detach(g);
+  mesh_.triangles[static_cast<size_t>(f)] = made[0];
+  mesh_.triangles[static_cast<size_t>(g)] = made[2];
+  const int f2 = add_face(made[1]), g2 = add_face(made[3]);
+  for (int h : {f, g, f2, g2}) {
+    attach(h);
+    touched.push_back(h);
+  }
+  ++splits_;
+  legalize(m, {{c, a}, {b, c}, {d, b}, {a, d}}, touched);
+  return true;
+}
+
+// Vertex `gone` merged into `kept` along their edge: allowed where the link
+// condition holds (their common neighbours are the two corners opposite the
+// edge, so the topology stays) and every triangle it leaves passes.
+bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
+  const int f = face_of(gone, kept), g = face_of(kept, gone);
+  if (f < 0 || g < 0) return false;
+  const std::vector<int> around_gone = ring(gone), around_kept = ring(kept);
+  if (around_gone.size() < 3 || around_kept.size() < 3 || around_gone.size() + around_kept.size() < 8) return false;
+  long common = 0;
+  for (int v : around_gone) common += std::count(around_kept.begin(), around_kept.end(), v);
+  if (common != 2) return false;
+  // The corners opposite the edge lose a neighbour: each keeps three.
+  if (ring(third(f, gone, kept)).size() < 4 || ring(third(g, gone, kept)).size() < 4) return false;
+  std::vector<int> fan;  // triangles around `gone` that stay, with `kept` in its place
+  for (int v : around_gone) {
+    const int h = face_of(gone, v);
+    if (h != f && h != g) fan.push_back(h);
+  }
+  std::vector<Triangle> renamed;
+  for (int h : fan) {
+    Triangle t = tri(h);
+    std::replace(t.begin(), t.end(), gone, kept);
+    if (!faces_out(t)) return false;
+    renamed.push_back(t);
+  }
+  // Judged before the edit, on a copy of each triangle.
+  for (size_t i = 0; i < fan.size(); ++i) {
+    const Triangle saved = tri(fan[i]);
+    mesh_.triangles[static_cast<size_t>(fan[i])] = renamed[i];
+    const bool passes = judge(fan[i]) == Verdict::pass;
+    mesh_.triangles[static_cast<size_t>(fan[i])] = saved;
+    if (!passes) return false;
+  }
+  detach(f);
+  detach(g);
+  for (int h : fan) detach(h);
+  alive_[static_cast<size_t>(f)] = alive_[static_cast<size_t>(g)] = 0;
+  for (size_t i = 0; i < fan.size(); ++i) {
+    mesh_.triangles[static_cast<size_t>(fan[i])] = renamed[i];
+    attach(fan[i]);
+    touched.push_back(fan[i]);
+  }
+  corner_face_[static_cast<size_t>(gone)] = -1;
+  ++contractions_;
+  return true;
+}
+
+// A failing triangle's shortest edge, when transport crowded its ends
+// together: the newer end goes (it was inserted later), else the other.
+bool Editor::try_contract(int f, std::vector<int>& touched) {
+  const Triangle t = tri(f);
+  size_t shortest = 0;
+  double best = INFINITY;
+  for (size_t k = 0; k < 3; ++k) {
+    const double len = (at(t[(k + 1) % 3]) - at(t[k])).norm();
+    if (len < best) best = len, shortest = k;
+  }
+  const int a = t[shortest], b = t[(shortest + 1) % 3];
+  const double target = std::min(
+      target_edge_length(complex_, at(a), mesh_.cells[static_cast<size_t>(a)], accept_),
+      target_edge_length(complex_, at(b), mesh_.cells[static_cast<size_t>(b)], accept_));
+  if (!(best < options_.contract_below * target)) return false;
+  return contract(std::max(a, b), std::min(a, b), touched) || contract(std::min(a, b), std::max(a, b), touched);
+}
+
+// Every edge shorter than thin_below times the target edge length at its
+// ends is contracted where that keeps every guarantee (contract): splits
+// add vertices where the skin stretches, and this takes them away where it
+// shrinks, so that the vertex count follows the surface.
+void Editor::thin_crowded(std::unordered_map<int, int>& seen) {
+  const size_t n = mesh_.vertices.size();
+  std::vector<double> target(n, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      if (corner_face_[v] >= 0) target[v] = target_edge_length(complex_, mesh_.vertices[v], mesh_.cells[v], accept_);
+  });
+  std::vector<int> touched;
+  const size_t faces = mesh_.triangles.size();
+  for (size_t f = 0; f < faces; ++f) {
+    if (!alive_[f]) continue;
+    for (size_t k = 0; k < 3; ++k) {
+      const Triangle& t = mesh_.triangles[f];
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a > b) continue;  // each edge once
+      const double limit = options_.thin_below * std::min(target[static_cast<size_t>(a)], target[static_cast<size_t>(b)]);
+      if (!((at(a) - at(b)).squaredNorm() < limit * limit)) continue;
+      touched.clear();
+      if (!contract(b, a, touched) && !contract(a, b, touched)) continue;
+      for (int h : touched) seen.emplace(h, 0);
+      break;  // this triangle is gone
+    }
+  }
+}
+
+Surgery Editor::run(const std::vector<char>& failing) {
+  std::deque<int> queue;
+  for (size_t f = 0; f < failing.size(); ++f)
+    if (failing[f]) queue.push_back(static_cast<int>(f));
+  const long budget = options_.edits_per_failing * static_cast<long>(queue.size()) + 64;
+  // Triangles to judge at the end, with the generation of the edit that
+  // made them (0: failing after transport).
+  std::unordered_map<int, int> seen;
+  for (int f : queue) seen[f] = 0;
+  long edits = 0;
+  std::vector<int> touched;
+  while (!queue.empty() && edits < budget) {
+    const int f = queue.front();
+    queue.pop_front();
+    const int generation = seen[f];
+    if (!alive_[static_cast<size_t>(f)] || generation >= options_.generations) continue;
+    const Verdict verdict = judge(f);
+    if (verdict == Verdict::pass || verdict == Verdict::inward) continue;
+    touched.clear();
+    bool mended = verdict == Verdict::shape && (try_contract(f, touched) || try_flip(f, touched));
+    if (!mended) mended = try_split(f, touched);
+    if (!mended) continue;  // left failing
+    ++edits;
+    for (int h : touched) {
+      queue.push_back(h);
+      seen[h] = generation + 1;
+    }
+  }
+  if (options_.thin_below > 0) thin_crowded(seen);
+  Surgery out;
+  std::vector<int> renumber(mesh_.vertices.size(), -1);
+  for (size_t v = 0; v < renumber.size(); ++v) {
+    if (corner_face_[v] < 0) continue;
+    renumber[v] = static_cast<int>(out.mesh.vertices.size());
+    out.mesh.vertices.push_back(mesh_.vertices[v]);
+    out.mesh.cells.push_back(mesh_.cells[v]);
+    out.mesh.normals.push_back(mesh_.normals[v]);
+    out.origin.push_back(v < vertices_before_ ? static_cast<long>(v) : -1);
+  }
+  for (size_t f = 0; f < mesh_.triangles.size(); ++f) {
+    if (!alive_[f]) continue;
+    const Triangle& t = mesh_.triangles[f];
+    out.mesh.triangles.push_back({renumber[static_cast<size_t>(t[0])], renumber[static_cast<size_t>(t[1])],
+                                  renumber[static_cast<size_t>(t[2])]});
+    out.failing.push_back(seen.count(static_cast<int>(f)) && judge(static_cast<int>(f)) != Verdict::pass);
+  }
+  out.left = std::count(out.failing.begin(), out.failing.end(), 1);
+  out.splits = splits_;
+  out.flips = flips_;
+  out.contractions = contractions_;
+  return out;
+}
+
+}  // namespace
+
+Surgery mend_by_edits(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                      const MeshingOptions& accept, const SurgeryOptions& options) {
+  Editor editor(complex, mesh, accept, options);
+  return editor.run(failing);
+}
+
+}  // namespace skinmesh::detail

@@ -1,0 +1,56 @@
+// Repair of a transported frame by edits of the mesh itself (private to
+// morph/): each failing triangle is mended by an edge split at a new skin
+// point, Delaunay edge flips around it, a flip alone, or the contraction of
+// a short edge, the "insert, remove, move or flip", with no
+// Delaunay triangulation built. Every edit keeps the mesh closed, oriented
+// and manifold and leaves its topology alone (a contraction is made only
+// where the link condition holds); every triangle an edit makes is judged
+// by the frame's criteria again. What the edits cannot mend is left
+// failing for the local repair (local_repair.hpp) or the frame's remesh.
+//
+// Why: a local repair builds a Delaunay triangulation of its patch with
+// context, about 2,000-4,000 points for a step of pept -> 3al1 at 2% of
+// the triangles failing, and CGAL inserts skin samples at about 4.5
+// microseconds a point here; a patch cost 20-40 ms, as much as remeshing
+// the whole frame (docs/morph.md, "Mending by edits").
+#pragma once
+
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+
+#include <vector>
+
+namespace skinmesh::detail {
+
+struct SurgeryOptions {
+  // A failing triangle whose shortest edge is below this times the target
+  // edge length at its ends is mended by contracting that edge (transport
+  // crowds vertices where a patch shrinks) before a split is tried.
+  double contract_below = 0.5;
+  // Edits at most this many times the failing triangles (plus 64), so that
+  // edits that chase each other stop; what is left stays failing.
+  long edits_per_failing = 12;
+  // A triangle made by an edit is mended in turn, down to this many
+  // generations from a triangle that failed after transport; past it the
+  // edits are chasing each other and the triangle is left failing.
+  int generations = 3;
+  // Then every edge shorter than this times the target edge length at its
+  // ends is contracted where every triangle left passes; 0: none.
+  double thin_below = 0.5;
+};
+
+struct Surgery {
+  SurfaceMesh mesh;             // the frame after the edits
+  std::vector<long> origin;     // per vertex: its index before, or -1 when inserted by a split
+  std::vector<char> failing;    // per triangle of `mesh`: still failing the criteria
+  long splits = 0, flips = 0, contractions = 0;
+  long left = 0;                // triangles still failing
+};
+
+// `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
+// skin of `complex`; the others are taken to pass.
+Surgery mend_by_edits(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                      const MeshingOptions& accept, const SurgeryOptions& options = {});
+
+}  // namespace skinmesh::detail
