@@ -78,7 +78,10 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
   Column c;
   const auto start = Clock::now();
   MorphOptions options;
-  if (!local_repair) options.local_repair_share = 0;
+  if (!local_repair) {  // c': every failing frame remeshed whole (no edits, no patches)
+    options.local_repair_share = 0;
+    options.edits = false;
+  }
   Morph morph = prepare_morph(p.source, p.target, ts.front(), options);
   c.seconds_first = seconds_since(start);
   c.seconds += c.seconds_first;
