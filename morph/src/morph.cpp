@@ -7,6 +7,7 @@
 
 #include "local_repair.hpp"
 #include "surgery.hpp"
+#include "vanishing.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -22,16 +23,19 @@ namespace {
 // The critical events in (from, to] as places where the local repair must
 // change the topology, with the change of the Euler characteristic they add
 // up to. A component or a void born (dimension 0 or 3, the Euler
-// characteristic up by 2) is seeded around its centre. False when one
-// vanishes (down by 2): its vertices are lost, and the frame is remeshed
-// whole. The patch reaches 1 A plus twice the feature's size at `to` from
-// the event's apex, past the vertices transport left around it.
-bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
-                          double to, detail::LocalRepairOptions& local) {
-  for (const TopologyEvent& e : events) {
-    if (!(e.t > from && e.t <= to)) continue;
+// characteristic up by 2) is seeded around its centre. One that vanishes
+// (down by 2) and was `handled` (its component dropped, drop_vanished) is
+// left out; one that was not is a place to remesh like a neck: its sphere
+// is then no component of its own in the mesh (a bulb that pinched off and
+// vanished within the step). The patch reaches 1 A plus twice the feature's
+// size at `to` from the event's apex, past the vertices transport left
+// around it.
+void add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
+                          double to, const std::vector<char>& handled, detail::LocalRepairOptions& local) {
+  for (size_t i = 0; i < events.size(); ++i) {
+    const TopologyEvent& e = events[i];
+    if (!(e.t > from && e.t <= to) || handled[i]) continue;
     const bool sphere = e.dim == 0 || e.dim == 3;
-    if (sphere && e.euler_change < 0) return false;
     const CellSize& size = sizes[static_cast<size_t>(e.cell)];
     const double feature = std::sqrt(std::abs(size.at(to)));
     detail::TopologyChange change;
@@ -43,7 +47,6 @@ bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::v
     local.changes.push_back(change);
     local.euler_change += e.euler_change;
   }
-  return true;
 }
 
 MeshingOptions with_size_margin(MeshingOptions o, double margin) {
@@ -88,7 +91,8 @@ void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria, dou
 // Transport (eq. 19) or, off the cell, projection onto the new skin from
 // the transported point. Returns per vertex 1 where it could not be put on
 // the skin (lost), else 0.
-std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const {
+std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
+                                       std::vector<char>& stayed) const {
   const size_t n = mesh.vertices.size();
   std::vector<char> state(n, 0);  // 0 moved, 1 lost, 2 relocated
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
@@ -112,8 +116,10 @@ std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mes
     }
   });
   std::vector<char> lost(n, 0);
+  stayed.assign(n, 0);
   for (size_t v = 0; v < n; ++v) {
     lost[v] = state[v] == 1;
+    stayed[v] = state[v] == 0;
     stats.moved += state[v] == 0;
     stats.relocated += state[v] == 2;
     stats.lost += state[v] == 1;
@@ -260,6 +266,55 @@ void Morph::finish_frame(double t, Clock::time_point start) {
   frame_.stats.seconds = seconds_since(start);
 }
 
+// A component or void that vanishes in the step (a critical event of
+// dimension 0 or 3 lowering the Euler characteristic) is found in the frame
+// before it (vanishing.hpp) and dropped from `moved`, with its vertices'
+// ids and their entries in `lost`. Returns per event whether its component
+// was dropped.
+std::vector<char> Morph::drop_vanished(double t, const std::vector<char>& stayed, SurfaceMesh& moved,
+                                       std::vector<char>& lost, FrameStats& stats) {
+  std::vector<char> handled(events_.size(), 0);
+  std::vector<detail::VanishingSphere> spheres;
+  std::vector<size_t> which;
+  for (size_t i = 0; i < events_.size(); ++i) {
+    const TopologyEvent& e = events_[i];
+    if (!(e.t > t_ && e.t <= t) || !(e.dim == 0 || e.dim == 3) || e.euler_change >= 0) continue;
+    const CellSize& size = sizes_[static_cast<size_t>(e.cell)];
+    spheres.push_back({size.center(t_), 1.0 + 2 * std::sqrt(std::abs(size.at(t_)))});
+    which.push_back(i);
+  }
+  if (spheres.empty()) return handled;
+  std::vector<char> found;
+  const std::vector<char> gone = detail::vanishing_components(frame_.mesh, stayed, spheres, found);
+  for (size_t k = 0; k < found.size(); ++k) handled[which[k]] = found[k];
+  if (std::find(found.begin(), found.end(), 1) == found.end()) return handled;
+  SurfaceMesh kept;
+  std::vector<long> ids;
+  std::vector<char> kept_lost;
+  std::vector<int> renumber(moved.vertices.size(), -1);
+  for (size_t v = 0; v < moved.vertices.size(); ++v) {
+    if (gone[v]) {
+      stats.lost -= lost[v];
+      stats.relocated -= !lost[v];
+      continue;
+    }
+    renumber[v] = static_cast<int>(kept.vertices.size());
+    kept.vertices.push_back(moved.vertices[v]);
+    kept.cells.push_back(moved.cells[v]);
+    kept.normals.push_back(moved.normals[v]);
+    ids.push_back(frame_.ids[v]);
+    kept_lost.push_back(lost[v]);
+  }
+  for (const auto& tri : moved.triangles)
+    if (!gone[static_cast<size_t>(tri[0])])  // a component's triangles go with it
+      kept.triangles.push_back({renumber[static_cast<size_t>(tri[0])], renumber[static_cast<size_t>(tri[1])],
+                                renumber[static_cast<size_t>(tri[2])]});
+  moved = std::move(kept);
+  lost = std::move(kept_lost);
+  frame_.ids = std::move(ids);
+  return handled;
+}
+
 const MorphFrame& Morph::advance_to(double t) {
   if (!(t > t_ && t <= 1)) contract_error("advance_to: t must lie after the current frame and at most 1");
   const auto start = Clock::now();
@@ -277,8 +332,11 @@ const MorphFrame& Morph::advance_to(double t) {
   }
   overlay_at(t, spare_);
   const SkinComplex& next = spare_;
+  const long first_new_id = next_id_, before = static_cast<long>(frame_.ids.size());
   SurfaceMesh moved = frame_.mesh;
-  std::vector<char> drop = move_vertices(next, moved, stats);
+  std::vector<char> stayed;
+  std::vector<char> drop = move_vertices(next, moved, stats, stayed);
+  const std::vector<char> handled = drop_vanished(t, stayed, moved, drop, stats);
   std::vector<char> failing;
   if (stats.lost == 0) {
     if (options_.relaxation.passes > 0) relax_tangentially(next, moved, options_.relaxation);
@@ -290,12 +348,12 @@ const MorphFrame& Morph::advance_to(double t) {
     frame_.mesh = std::move(moved);  // ids stay: every vertex survives
   } else {
     const auto repair_start = Clock::now();
-    const long first_new_id = next_id_, before = static_cast<long>(frame_.ids.size());
-    // Edits and local repair are for frames without lost vertices or a
-    // vanishing component or void; the others are remeshed whole.
+    // Edits and local repair are for frames without lost vertices; the
+    // others are remeshed whole.
     detail::LocalRepairOptions local;
     local.crowded_below = options_.crowded_below;
-    const bool mendable = stats.lost == 0 && add_topology_changes(events_, sizes_, t_, t, local);
+    add_topology_changes(events_, sizes_, t_, t, handled, local);
+    const bool mendable = stats.lost == 0;
     long left = stats.bad_triangles;
     EditCounts edited;
     if (mendable && left > 0 && options_.edits) left = mend_by_edits(next, moved, failing, drop, edited);

@@ -387,3 +387,26 @@ TEST_CASE("synthetic events: a component born far from the rest is meshed locall
   CHECK(local_births == 1);
   check_events_cover_changes(prepare_morph(source, target, 0.0), records);
 }
+
+TEST_CASE("synthetic events: a component that vanishes far from the rest is dropped locally", "[morph][events]") {
+  // The birth above run backwards: the small ball's pair has negative
+  // weight from t = 0.035 on. The step holding its death drops the small
+  // sphere's component (found in the frame before, wholly within reach of
+  // the event's apex, no vertex still in its cell) and keeps the large one
+  // as transported: no remesh. Every frame checked against CGAL's certified
+  // skin mesh of B(t).
+  const std::vector<Ball> source{lone(0, 0, 0, 3.0), lone(12, 0, 0, 1.5)};
+  const std::vector<Ball> target{lone(0, 0, 0, 3.0)};
+  const std::vector<double> times{0.01, 0.02, 0.03, 0.04, 0.05, 0.06};
+  const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin);
+  CHECK(records.front().components == 2);
+  CHECK(records.back().components == 1);
+  long local_deaths = 0;
+  for (const FrameRecord& r : records) {
+    INFO("t = " << r.t << ": events " << r.stats.events << ", remeshed " << r.stats.remeshed << ", removed "
+                << r.stats.removed);
+    local_deaths += r.stats.events > 0 && r.stats.repaired && !r.stats.remeshed && !r.stats.full_rebuild;
+  }
+  CHECK(local_deaths == 1);
+  check_events_cover_changes(prepare_morph(source, target, 0.0), records);
+}

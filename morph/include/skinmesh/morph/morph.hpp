@@ -154,7 +154,10 @@ class Morph {
   };
   long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                      std::vector<char>& drop, EditCounts& counts);
-  std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats) const;
+  std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
+                                  std::vector<char>& stayed) const;
+  std::vector<char> drop_vanished(double t, const std::vector<char>& stayed, SurfaceMesh& moved,
+                                  std::vector<char>& lost, FrameStats& stats);
   bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
                       const detail::LocalRepairOptions& local);
   long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
