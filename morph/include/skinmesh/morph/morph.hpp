@@ -2,25 +2,33 @@
 // and advanced frame by frame: the complex of B(1/2) of the live pairs is
 // built once and moved to each frame (SkinComplex::with_balls); every vertex
 // is transported inside its cell (eq. 19) or, where it left its cell,
-// projected back onto the new skin; every triangle is then judged by the
-// mesher's own criteria (restricted_triangle, triangle_defect).
+// projected back onto the new skin; the vertices are relaxed along the skin
+// and every triangle is judged by the mesher's own criteria
+// (restricted_triangle, triangle_defect).
 //
-// Repair: the failing triangles of a frame, and those around a neck that
-// opened or pinched since the last frame (a critical topology event of
-// dimension 1 or 2), grown by a ring, are remeshed by restricted Delaunay
-// refinement of their own vertices, with seeds on any component or void
-// born since (dimension 0 or 3), and stitched back (local repair), the
-// Euler characteristic checked against the events'; the rest of the mesh
-// is kept as transported. A frame where that fails, a vertex is lost (its
-// cell's size vanished and no skin point is near), or a component or void
-// vanishes since the last frame, is remeshed as a whole from its own
-// transported vertices
-// (remesh_skin): they are kept, those transport crowded together removed,
-// and restricted Delaunay refinement inserts points only where a triangle
-// fails, and seeds only on skin the vertices miss (a component born, a neck
-// opened). Only when that fails is the frame meshed from
-// scratch (FrameStats::full_rebuild). Every frame is a correct quality mesh
-// of the skin of B(t) either way.
+// Repair, cheapest first:
+// - a component or void that vanished since the last frame (a critical
+//   event of dimension 0 or 3 lowering the Euler characteristic) is dropped
+//   with its vertices, when the frame before holds it as a component of its
+//   own;
+// - failing triangles are mended by edits of the mesh: edge splits at new
+//   skin points with Delaunay flips around them, flips, contractions of
+//   short edges (MorphOptions::edits);
+// - what the edits leave, and the places where a neck opened or pinched or
+//   a component or void was born (dimension 0 or 3, seeded), grown by a
+//   ring, are remeshed by restricted Delaunay refinement of their own
+//   vertices and stitched back (local repair), the Euler characteristic
+//   checked against the events';
+// - a frame where that fails or a vertex is lost (its cell's size vanished
+//   and no skin point is near) is remeshed as a whole from its transported
+//   vertices (remesh_skin): they are kept, those transport crowded together
+//   removed, and refinement inserts points only where a triangle fails, and
+//   seeds only on skin the vertices miss. Only when that fails is the frame
+//   meshed from scratch (FrameStats::full_rebuild).
+// Every triangle of every frame meets the frame criteria, whichever path
+// made it; `skinmesh morph` also checks each frame as a whole (closed,
+// manifold, no self-intersections, every vertex on the skin by the morph
+// oracle) before it writes anything.
 #pragma once
 
 #include "skinmesh/core/interpolation.hpp"
