@@ -152,6 +152,15 @@ std::vector<Ball> molecule_balls(const char* file, int model = 1) {
   return balls;
 }
 
+// 2k39 model 1 -> 3 at t = first/100, (first+1)/100, ..., last/100, every
+// frame checked against the static mesher as above.
+std::vector<FrameRecord> check_2k39_steps(int first, int last) {
+  std::vector<double> times;
+  for (int k = first; k <= last; ++k) times.push_back(k / 100.0);
+  return check_frames(molecule_balls("2k39_3models.pdb", 1), molecule_balls("2k39_3models.pdb", 3), times,
+                      Reference::static_mesher);
+}
+
 const std::vector<double> kSixFrames{0.0, 0.2, 0.4, 0.6, 0.8, 1.0};
 
 Ball lone(double x, double y, double z, double skin_radius) {
@@ -291,11 +300,7 @@ TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: failing triangles are mende
   // self-intersections, and the static mesher's mesh of B(t) from scratch
   // (components, Euler characteristic, two-sided distance). Without the
   // edits none of these frames is mended so.
-  std::vector<double> times;
-  for (int k = 2; k <= 12; ++k) times.push_back(k / 100.0);
-  const std::vector<FrameRecord> records =
-      check_frames(molecule_balls("2k39_3models.pdb", 1), molecule_balls("2k39_3models.pdb", 3), times,
-                   Reference::static_mesher);
+  const std::vector<FrameRecord> records = check_2k39_steps(2, 12);
   long mended = 0;
   for (const FrameRecord& r : records) {
     const FrameStats& s = r.stats;
@@ -354,11 +359,7 @@ TEST_CASE("morph 2k39 model 1 -> 3: a neck that opens or pinches between frames 
   // patch is taken only when the Euler characteristic changes as the events
   // say. Every frame checked as for the other pairs (the static mesher's
   // components and Euler characteristic, the morph oracle, the grader).
-  std::vector<double> times;
-  for (int k = 46; k <= 56; ++k) times.push_back(k / 100.0);
-  const std::vector<FrameRecord> records =
-      check_frames(molecule_balls("2k39_3models.pdb", 1), molecule_balls("2k39_3models.pdb", 3), times,
-                   Reference::static_mesher);
+  const std::vector<FrameRecord> records = check_2k39_steps(46, 56);
   long local_events = 0;
   for (const FrameRecord& r : records)
     local_events += r.stats.events > 0 && r.stats.patch_triangles > 0 && !r.stats.remeshed && !r.stats.full_rebuild;
