@@ -11,7 +11,7 @@
 // Why: a local repair builds a Delaunay triangulation of its patch with
 // context, about 2,000-4,000 points for a step of pept -> 3al1 at 2% of
 // the triangles failing, and CGAL inserts skin samples at about 4.5
-// microseconds a point here; a patch cost 20-40 ms, as much as remeshing
+// microseconds a point here; a patch cost 20-70 ms, as much as remeshing
 // the whole frame (docs/morph.md, "Mending by edits").
 #pragma once
 
