@@ -1,5 +1,7 @@
 #include "local_repair.hpp"
 
+#include "mesh_part.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -245,20 +247,9 @@ std::pair<long, long> components_and_euler(const SurfaceMesh& mesh) {
 // Drops the vertices no triangle uses and renumbers; origin maps each
 // vertex back to the mesh before (or -1).
 void compact(const SurfaceMesh& merged, size_t old_vertices, LocalRepair& out) {
-  std::vector<int> renumber(merged.vertices.size(), -1);
-  for (const Triangle& t : merged.triangles)
-    for (int v : t) renumber[static_cast<size_t>(v)] = 0;
-  for (size_t v = 0; v < renumber.size(); ++v) {
-    if (renumber[v] < 0) continue;
-    renumber[v] = static_cast<int>(out.mesh.vertices.size());
-    out.mesh.vertices.push_back(merged.vertices[v]);
-    out.mesh.cells.push_back(merged.cells[v]);
-    out.mesh.normals.push_back(merged.normals[v]);
-    out.origin.push_back(v < old_vertices ? static_cast<long>(v) : -1);
-  }
-  for (const Triangle& t : merged.triangles)
-    out.mesh.triangles.push_back({renumber[static_cast<size_t>(t[0])], renumber[static_cast<size_t>(t[1])],
-                                  renumber[static_cast<size_t>(t[2])]});
+  std::vector<int> kept_from;
+  out.mesh = used_part(merged, {}, kept_from);
+  for (int v : kept_from) out.origin.push_back(static_cast<size_t>(v) < old_vertices ? v : -1);
 }
 
 }  // namespace

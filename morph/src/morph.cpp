@@ -6,6 +6,7 @@
 #include "skinmesh/morph/transport.hpp"
 
 #include "local_repair.hpp"
+#include "mesh_part.hpp"
 #include "surgery.hpp"
 #include "vanishing.hpp"
 
@@ -163,16 +164,11 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
   detail::LocalRepair r =
       detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
   if (!r.ok) return false;
-  std::vector<long> ids(r.origin.size());
-  long kept = 0;
-  for (size_t v = 0; v < ids.size(); ++v) {
+  std::vector<long> ids(r.origin.size());  // inserted and removed are counted by ids (advance_to)
+  for (size_t v = 0; v < ids.size(); ++v)
     ids[v] = r.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(r.origin[v])] : next_id_++;
-    kept += r.origin[v] >= 0;
-  }
   frame_.stats.repaired = true;
   frame_.stats.patch_triangles = r.patch_triangles;
-  frame_.stats.inserted = static_cast<long>(ids.size()) - kept;
-  frame_.stats.removed = static_cast<long>(moved.vertices.size()) - kept;
   frame_.stats.repairs = r.repairs;
   frame_.mesh = std::move(r.mesh);
   frame_.ids = std::move(ids);
@@ -184,7 +180,7 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
 // its vertices. Returns how many triangles still fail.
 long Morph::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                           std::vector<char>& drop, EditCounts& counts) {
-  detail::Surgery s = detail::mend_by_edits(next, moved, failing, options_.frames);
+  detail::Surgery s = detail::mend_by_edits(next, std::move(moved), failing, options_.frames);
   std::vector<long> ids(s.origin.size());
   for (size_t v = 0; v < ids.size(); ++v)
     ids[v] = s.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(s.origin[v])] : next_id_++;
@@ -291,28 +287,22 @@ std::vector<char> Morph::drop_vanished(double t, const std::vector<char>& stayed
   const std::vector<char> gone = detail::vanishing_components(frame_.mesh, stayed, spheres, found);
   for (size_t k = 0; k < found.size(); ++k) handled[which[k]] = found[k];
   if (std::find(found.begin(), found.end(), 1) == found.end()) return handled;
-  SurfaceMesh kept;
-  std::vector<long> ids;
-  std::vector<char> kept_lost;
-  std::vector<int> renumber(moved.vertices.size(), -1);
-  for (size_t v = 0; v < moved.vertices.size(); ++v) {
+  for (size_t v = 0; v < gone.size(); ++v)
     if (gone[v]) {
       stats.lost -= lost[v];
       stats.relocated -= !lost[v];
-      continue;
     }
-    renumber[v] = static_cast<int>(kept.vertices.size());
-    kept.vertices.push_back(moved.vertices[v]);
-    kept.cells.push_back(moved.cells[v]);
-    kept.normals.push_back(moved.normals[v]);
-    ids.push_back(frame_.ids[v]);
-    kept_lost.push_back(lost[v]);
+  std::vector<char> keep(moved.triangles.size());
+  for (size_t f = 0; f < keep.size(); ++f)  // a component's triangles go with it
+    keep[f] = !gone[static_cast<size_t>(moved.triangles[f][0])];
+  std::vector<int> kept_from;
+  moved = detail::used_part(moved, keep, kept_from);
+  std::vector<long> ids;
+  std::vector<char> kept_lost;
+  for (int v : kept_from) {
+    ids.push_back(frame_.ids[static_cast<size_t>(v)]);
+    kept_lost.push_back(lost[static_cast<size_t>(v)]);
   }
-  for (const auto& tri : moved.triangles)
-    if (!gone[static_cast<size_t>(tri[0])])  // a component's triangles go with it
-      kept.triangles.push_back({renumber[static_cast<size_t>(tri[0])], renumber[static_cast<size_t>(tri[1])],
-                                renumber[static_cast<size_t>(tri[2])]});
-  moved = std::move(kept);
   lost = std::move(kept_lost);
   frame_.ids = std::move(ids);
   return handled;

@@ -1,5 +1,7 @@
 #include "surgery.hpp"
 
+#include "mesh_part.hpp"
+
 #include <Eigen/Geometry>
 
 #include <tbb/blocked_range.h>
@@ -10,6 +12,7 @@
 #include <cstdint>
 #include <deque>
 #include <unordered_map>
+#include <utility>
 
 namespace skinmesh::detail {
 namespace {
@@ -31,9 +34,12 @@ double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eig
 // triangle of a closed oriented manifold), edited in place.
 class Editor {
  public:
-  Editor(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& accept,
-         const SurgeryOptions& options)
-      : complex_(complex), mesh_(mesh), accept_(accept), options_(options), vertices_before_(mesh.vertices.size()) {
+  Editor(const SkinComplex& complex, SurfaceMesh mesh, const MeshingOptions& accept, const SurgeryOptions& options)
+      : complex_(complex),
+        mesh_(std::move(mesh)),
+        accept_(accept),
+        options_(options),
+        vertices_before_(mesh_.vertices.size()) {  // mesh_ is declared (so initialised) first
     if (mesh_.normals.size() != mesh_.vertices.size()) {
       mesh_.normals.resize(mesh_.vertices.size());
       for (size_t v = 0; v < mesh_.vertices.size(); ++v)
@@ -368,22 +374,12 @@ Surgery Editor::run(const std::vector<char>& failing) {
   }
   if (options_.thin_below > 0) thin_crowded(seen);
   Surgery out;
-  std::vector<int> renumber(mesh_.vertices.size(), -1);
-  for (size_t v = 0; v < renumber.size(); ++v) {
-    if (corner_face_[v] < 0) continue;
-    renumber[v] = static_cast<int>(out.mesh.vertices.size());
-    out.mesh.vertices.push_back(mesh_.vertices[v]);
-    out.mesh.cells.push_back(mesh_.cells[v]);
-    out.mesh.normals.push_back(mesh_.normals[v]);
-    out.origin.push_back(v < vertices_before_ ? static_cast<long>(v) : -1);
-  }
-  for (size_t f = 0; f < mesh_.triangles.size(); ++f) {
-    if (!alive_[f]) continue;
-    const Triangle& t = mesh_.triangles[f];
-    out.mesh.triangles.push_back({renumber[static_cast<size_t>(t[0])], renumber[static_cast<size_t>(t[1])],
-                                  renumber[static_cast<size_t>(t[2])]});
-    out.failing.push_back(seen.count(static_cast<int>(f)) && judge(static_cast<int>(f)) != Verdict::pass);
-  }
+  std::vector<int> kept_from;
+  out.mesh = used_part(mesh_, alive_, kept_from);
+  for (int v : kept_from) out.origin.push_back(static_cast<size_t>(v) < vertices_before_ ? v : -1);
+  for (size_t f = 0; f < mesh_.triangles.size(); ++f)
+    if (alive_[f])
+      out.failing.push_back(seen.count(static_cast<int>(f)) && judge(static_cast<int>(f)) != Verdict::pass);
   out.left = std::count(out.failing.begin(), out.failing.end(), 1);
   out.splits = splits_;
   out.flips = flips_;
@@ -393,9 +389,9 @@ Surgery Editor::run(const std::vector<char>& failing) {
 
 }  // namespace
 
-Surgery mend_by_edits(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
                       const MeshingOptions& accept, const SurgeryOptions& options) {
-  Editor editor(complex, mesh, accept, options);
+  Editor editor(complex, std::move(mesh), accept, options);
   return editor.run(failing);
 }
 

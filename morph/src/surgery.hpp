@@ -50,7 +50,7 @@ struct Surgery {
 
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
 // skin of `complex`; the others are taken to pass.
-Surgery mend_by_edits(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
                       const MeshingOptions& accept, const SurgeryOptions& options = {});
 
 }  // namespace skinmesh::detail
