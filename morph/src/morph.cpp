@@ -180,7 +180,8 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
 // its vertices. Returns how many triangles still fail.
 long Morph::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                           std::vector<char>& drop, EditCounts& counts) {
-  detail::Surgery s = detail::mend_by_edits(next, std::move(moved), failing, options_.frames);
+  detail::Surgery s =
+      detail::mend_by_edits(next, std::move(moved), failing, options_.frames, {}, &frame_.ids, &refused_thinning_);
   std::vector<long> ids(s.origin.size());
   for (size_t v = 0; v < ids.size(); ++v)
     ids[v] = s.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(s.origin[v])] : next_id_++;

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 
@@ -51,7 +52,7 @@ class Editor {
     for (int f = 0; f < static_cast<int>(mesh_.triangles.size()); ++f) attach(f);
   }
 
-  Surgery run(const std::vector<char>& failing);
+  Surgery run(const std::vector<char>& failing, const std::vector<long>* ids, RefusedEdges* refused);
 
  private:
   const Triangle& tri(int f) const { return mesh_.triangles[static_cast<size_t>(f)]; }
@@ -99,7 +100,7 @@ class Editor {
   bool try_split(int f, std::vector<int>& touched);
   bool try_contract(int f, std::vector<int>& touched);
   bool contract(int gone, int kept, std::vector<int>& touched);
-  void thin_crowded(std::unordered_map<int, int>& seen);
+  void thin_crowded(std::unordered_map<int, int>& seen, const std::vector<long>* ids, RefusedEdges* refused);
 
   const SkinComplex& complex_;
   SurfaceMesh mesh_;
@@ -109,7 +110,7 @@ class Editor {
   std::vector<int> corner_face_;  // per vertex: a triangle it is a corner of (-1: gone)
   std::unordered_map<uint64_t, int> edges_;
   size_t vertices_before_;
-  long splits_ = 0, flips_ = 0, contractions_ = 0;
+  long splits_ = 0, flips_ = 0, contractions_ = 0, thin_tried_ = 0;
 };
 
 std::vector<int> Editor::ring(int v) const {
@@ -319,8 +320,28 @@ bool Editor::try_contract(int f, std::vector<int>& touched) {
 // ends is contracted where that keeps every guarantee (contract): splits
 // add vertices where the skin stretches, and this takes them away where it
 // shrinks, so that the vertex count follows the surface.
-void Editor::thin_crowded(std::unordered_map<int, int>& seen) {
+void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<long>* ids, RefusedEdges* refused) {
   const size_t n = mesh_.vertices.size();
+  RefusedEdges before;
+  if (refused) before.swap(*refused);
+  // The edge a - b by the ids of its ends; none without a memo, or for a
+  // vertex a split made in this frame (its edges are new).
+  auto key_of = [&](int a, int b) -> std::optional<std::pair<long, long>> {
+    if (!ids || !refused || static_cast<size_t>(std::max(a, b)) >= ids->size()) return std::nullopt;
+    const long ia = (*ids)[static_cast<size_t>(a)], ib = (*ids)[static_cast<size_t>(b)];
+    return std::make_pair(std::min(ia, ib), std::max(ia, ib));
+  };
+  // Refused in a frame before, neither shrunk since nor aged: skipped, and
+  // remembered a frame older.
+  auto still_refused = [&](const std::optional<std::pair<long, long>>& key, double length) {
+    if (!key) return false;
+    const auto it = before.find(*key);
+    if (it == before.end()) return false;
+    const auto [length_then, age] = it->second;
+    if (length < (1 - options_.retry_shrink) * length_then || age + 1 >= options_.retry_after_frames) return false;
+    refused->emplace(*key, std::make_pair(length_then, age + 1));
+    return true;
+  };
   std::vector<double> target(n, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v)
@@ -335,16 +356,22 @@ void Editor::thin_crowded(std::unordered_map<int, int>& seen) {
       const int a = t[k], b = t[(k + 1) % 3];
       if (a > b) continue;  // each edge once
       const double limit = options_.thin_below * std::min(target[static_cast<size_t>(a)], target[static_cast<size_t>(b)]);
-      if (!((at(a) - at(b)).squaredNorm() < limit * limit)) continue;
+      const double length = (at(a) - at(b)).norm();
+      const auto key = key_of(a, b);
+      if (!(length < limit) || still_refused(key, length)) continue;
       touched.clear();
-      if (!contract(b, a, touched) && !contract(a, b, touched)) continue;
+      ++thin_tried_;
+      if (!contract(b, a, touched) && !contract(a, b, touched)) {
+        if (key) refused->emplace(*key, std::make_pair(length, 0));
+        continue;
+      }
       for (int h : touched) seen.emplace(h, 0);
       break;  // this triangle is gone
     }
   }
 }
 
-Surgery Editor::run(const std::vector<char>& failing) {
+Surgery Editor::run(const std::vector<char>& failing, const std::vector<long>* ids, RefusedEdges* refused) {
   std::deque<int> queue;
   for (size_t f = 0; f < failing.size(); ++f)
     if (failing[f]) queue.push_back(static_cast<int>(f));
@@ -372,7 +399,7 @@ Surgery Editor::run(const std::vector<char>& failing) {
       seen[h] = generation + 1;
     }
   }
-  if (options_.thin_below > 0) thin_crowded(seen);
+  if (options_.thin_below > 0) thin_crowded(seen, ids, refused);
   Surgery out;
   std::vector<int> kept_from;
   out.mesh = used_part(mesh_, alive_, kept_from);
@@ -384,15 +411,17 @@ Surgery Editor::run(const std::vector<char>& failing) {
   out.splits = splits_;
   out.flips = flips_;
   out.contractions = contractions_;
+  out.thin_tried = thin_tried_;
   return out;
 }
 
 }  // namespace
 
 Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
-                      const MeshingOptions& accept, const SurgeryOptions& options) {
+                      const MeshingOptions& accept, const SurgeryOptions& options, const std::vector<long>* ids,
+                      RefusedEdges* refused) {
   Editor editor(complex, std::move(mesh), accept, options);
-  return editor.run(failing);
+  return editor.run(failing, ids, refused);
 }
 
 }  // namespace skinmesh::detail

@@ -19,6 +19,8 @@
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
 
+#include <map>
+#include <utility>
 #include <vector>
 
 namespace skinmesh::detail {
@@ -38,19 +40,36 @@ struct SurgeryOptions {
   // Then every edge shorter than this times the target edge length at its
   // ends is contracted where every triangle left passes; 0: none.
   double thin_below = 0.5;
+  // A thinning contraction refused in an earlier frame is tried again only
+  // when its edge has shrunk by this share since, or after this many frames.
+  // Most short edges are refused frame after frame (2k39 model 1 -> 3: about
+  // 750 tried a frame, 93% refused, each judging up to a fan of triangles):
+  // they are short by design where the mesh was refined with room.
+  double retry_shrink = 0.05;
+  int retry_after_frames = 8;
 };
+
+// Thinning contractions refused, by the vertex ids of the edge's ends
+// (smaller first): the edge's length then and the frames since. Kept by the
+// caller from frame to frame.
+using RefusedEdges = std::map<std::pair<long, long>, std::pair<double, int>>;
 
 struct Surgery {
   SurfaceMesh mesh;             // the frame after the edits
   std::vector<long> origin;     // per vertex: its index before, or -1 when inserted by a split
   std::vector<char> failing;    // per triangle of `mesh`: still failing the criteria
   long splits = 0, flips = 0, contractions = 0;
+  long thin_tried = 0;          // edges thinning tried to contract (not those skipped as refused before)
   long left = 0;                // triangles still failing
 };
 
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
-// skin of `complex`; the others are taken to pass.
+// skin of `complex`; the others are taken to pass. With `ids` (per vertex of
+// `mesh`, stable from frame to frame) and `refused`, thinning skips the
+// edges refused before (SurgeryOptions::retry_shrink) and `refused` becomes
+// this frame's.
 Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
-                      const MeshingOptions& accept, const SurgeryOptions& options = {});
+                      const MeshingOptions& accept, const SurgeryOptions& options = {},
+                      const std::vector<long>* ids = nullptr, RefusedEdges* refused = nullptr);
 
 }  // namespace skinmesh::detail

@@ -40,6 +40,8 @@
 #include "skinmesh/morph/relaxation.hpp"
 
 #include <array>
+#include <map>
+#include <utility>
 #include <vector>
 
 namespace skinmesh {
@@ -186,6 +188,9 @@ class Morph {
   MorphFrame frame_;
   double t_ = 0;
   long next_id_ = 0;
+  // Thinning contractions the edits were refused, kept for the next frame's
+  // (detail::RefusedEdges in surgery.hpp).
+  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;
 };
 
 // Live pairs, the complex of B(1/2), the topology events, and the first

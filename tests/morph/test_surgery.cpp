@@ -1,0 +1,67 @@
+// The edits' thinning (morph/src/surgery.hpp, private to morph/): an edge
+// whose contraction was refused is not tried again in the next frame unless
+// it has shrunk or its refusal has aged.
+#include <catch2/catch.hpp>
+
+#include "test_support.hpp"
+
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "surgery.hpp"
+
+#include <numeric>
+
+using namespace skinmesh;
+
+TEST_CASE("edits: thinning skips an edge refused in the frame before until it shrinks or its refusal ages",
+          "[morph]") {
+  const std::vector<Ball> balls = test::centred_model(std::string(SKINMESH_DATA_DIR) + "/pept.pdb", 1);
+  const SkinComplex complex = build_skin_complex(balls);
+  // Meshed at the mesher's 30 degrees and judged at the frames' 20: the
+  // refinement leaves edges under half the target length, most of which
+  // cannot go without a triangle failing.
+  const SkinMeshResult made = mesh_skin(complex, MeshingOptions{});
+  REQUIRE(made.status == MeshingStatus::ok);
+  MeshingOptions accept;
+  accept.min_angle = 20;
+  std::vector<long> ids(made.mesh.vertices.size());
+  std::iota(ids.begin(), ids.end(), 100);
+  const std::vector<char> none_failing(made.mesh.triangles.size(), 0);
+  const detail::SurgeryOptions options;
+  auto thin = [&](detail::RefusedEdges& refused) {
+    return detail::mend_by_edits(complex, made.mesh, none_failing, accept, options, &ids, &refused);
+  };
+
+  detail::RefusedEdges refused;
+  const detail::Surgery first = thin(refused);
+  REQUIRE(first.thin_tried > 0);
+  REQUIRE(!refused.empty());
+  const long refused_first = static_cast<long>(refused.size());
+  CHECK(refused_first < first.thin_tried);  // some were contracted
+
+  SECTION("the same frame again: none of the refused edges is tried") {
+    const detail::RefusedEdges before = refused;
+    const detail::Surgery second = thin(refused);
+    // An edge is skipped even where a contraction beside it would have let
+    // it go later in the pass; so at most the others are tried.
+    CHECK(second.thin_tried <= first.thin_tried - refused_first);
+    CHECK(second.contractions > 0);
+    for (const auto& [edge, memo] : before) {
+      const auto carried = refused.find(edge);
+      REQUIRE(carried != refused.end());
+      CHECK(carried->second.first == memo.first);
+      CHECK(carried->second.second == 1);  // a frame older
+    }
+  }
+  SECTION("edges shorter than when refused are tried again") {
+    for (auto& [edge, memo] : refused) memo.first /= 1 - 2 * options.retry_shrink;
+    CHECK(thin(refused).thin_tried == first.thin_tried);
+  }
+  SECTION("a refusal as old as retry_after_frames is tried again") {
+    for (auto& [edge, memo] : refused) memo.second = options.retry_after_frames - 1;
+    CHECK(thin(refused).thin_tried == first.thin_tried);
+  }
+  SECTION("without ids every short edge is tried") {
+    const detail::Surgery plain = detail::mend_by_edits(complex, made.mesh, none_failing, accept, options);
+    CHECK(plain.thin_tried == first.thin_tried);
+  }
+}
