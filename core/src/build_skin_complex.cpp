@@ -45,21 +45,19 @@ bool clearly_not_flat(const Mat& g) {
 }
 
 // Centre z_X (equal power to every ball of X within aff(delta_X)), size R2 and
-// the projector onto the directions of aff(delta_X) (docs/math.md section 3).
-void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
+// the projector onto the directions of aff(delta_X) (docs/math.md section 3),
+// for a simplex of D+1 balls. Fixed-size matrices: a morph moves its complex
+// every frame, and with matrices of dynamic size (at most 3) this was a
+// fifth of a frame of 2k39 model 1 -> 3 (perf). The inverse is LU's, as
+// Eigen's dynamic-size inverse is, not the closed-form cofactors.
+template <int D>
+void simplex_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
+  using Mat = Eigen::Matrix<double, D, D>;
+  using Vec = Eigen::Matrix<double, D, 1>;
   const Ball& b0 = balls[cell.balls[0]];
-  const int d = cell.dim;
-  if (d == 0) {
-    cell.center = b0.center;
-    cell.R2 = -b0.weight;
-    return;
-  }
-  // Fixed capacity (at most 3 directions): no heap allocation per cell.
-  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
-  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
-  Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3> E(3, d);
-  Vec rhs(d);
-  for (int j = 0; j < d; ++j) {
+  Eigen::Matrix<double, 3, D> E;
+  Vec rhs;
+  for (int j = 0; j < D; ++j) {
     const Ball& bj = balls[cell.balls[j + 1]];
     E.col(j) = bj.center - b0.center;
     // |z - z_j|^2 - w_j = |z - z_0|^2 - w_0  <=>  2 <z - z_0, e_j> = |e_j|^2 - w_j + w_0
@@ -68,10 +66,10 @@ void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
   const Mat gram = E.transpose() * E;
   Mat gram_inv;
   if (clearly_not_flat(gram)) {
-    gram_inv = gram.inverse();
+    gram_inv = gram.partialPivLu().inverse();
   } else if (const Vec values = Eigen::SelfAdjointEigenSolver<Mat>(gram, Eigen::EigenvaluesOnly).eigenvalues();
              values.minCoeff() > 1e-14 * values.maxCoeff()) {
-    gram_inv = gram.inverse();
+    gram_inv = gram.partialPivLu().inverse();
   } else {
     const double largest = values.maxCoeff();
     // Affinely dependent vertices (a flat simplex from cospherical input):
@@ -79,7 +77,7 @@ void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
     cell.degenerate = true;
     const Eigen::SelfAdjointEigenSolver<Mat> eig(gram);
     Vec inv = eig.eigenvalues();
-    for (int i = 0; i < d; ++i) inv[i] = inv[i] > 1e-14 * largest ? 1.0 / inv[i] : 0.0;
+    for (int i = 0; i < D; ++i) inv[i] = inv[i] > 1e-14 * largest ? 1.0 / inv[i] : 0.0;
     gram_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
   }
   const Vec a = 0.5 * gram_inv * rhs;
@@ -87,8 +85,22 @@ void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
   cell.center = b0.center + offset;
   cell.R2 = offset.squaredNorm() - b0.weight;
   cell.P = E * gram_inv * E.transpose();
-  const Mat affine = gram_inv * E.transpose();
-  for (int j = 0; j < d; ++j) cell.to_affine.row(j) = affine.row(j);
+  const Eigen::Matrix<double, D, 3> affine = gram_inv * E.transpose();
+  for (int j = 0; j < D; ++j) cell.to_affine.row(j) = affine.row(j);
+}
+
+void compute_cell_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
+  switch (cell.dim) {
+    case 0: {
+      const Ball& b0 = balls[cell.balls[0]];
+      cell.center = b0.center;
+      cell.R2 = -b0.weight;
+      return;
+    }
+    case 1: return simplex_geometry<1>(cell, balls);
+    case 2: return simplex_geometry<2>(cell, balls);
+    default: return simplex_geometry<3>(cell, balls);
+  }
 }
 
 // A cell X whose coface Y is flat (see compute_cell_geometry) would take
