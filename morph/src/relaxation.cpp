@@ -3,7 +3,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
+#include <vector>
 
 namespace skinmesh {
 
@@ -40,7 +42,9 @@ long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const Rel
     mesh.normals.resize(n);
     for (size_t v = 0; v < n; ++v) mesh.normals[v] = complex.evaluate(mesh.vertices[v], mesh.cells[v]).gradient.normalized();
   }
+  std::vector<char> moved(n);  // per pass: the vertex moved (its normal is evaluated again)
   for (int pass = 0; pass < options.passes; ++pass) {
+    std::fill(moved.begin(), moved.end(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
       long refused_here = 0;
       for (size_t v = r.begin(); v != r.end(); ++v) {
@@ -49,11 +53,18 @@ long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const Rel
         const int begin = offsets[v], end = offsets[v + 1];
         if (begin == end) continue;
         Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (int k = begin; k < end; ++k) centroid += mesh.vertices[static_cast<size_t>(indices[static_cast<size_t>(k)])];
+        double spacing = 0;  // mean distance to the neighbours
+        for (int k = begin; k < end; ++k) {
+          const Eigen::Vector3d& u = mesh.vertices[static_cast<size_t>(indices[static_cast<size_t>(k)])];
+          centroid += u;
+          spacing += (u - mesh.vertices[v]).norm();
+        }
         centroid /= static_cast<double>(end - begin);
+        spacing /= static_cast<double>(end - begin);
         const Eigen::Vector3d normal = mesh.normals[v];
         Eigen::Vector3d way = centroid - mesh.vertices[v];
         way -= way.dot(normal) * normal;
+        if (way.norm() < options.settled_below * spacing) continue;  // settled: stays
         const Projection p = complex.project(mesh.vertices[v] + options.weight * way, mesh.cells[v], 1e-14);
         if (!p.converged || (p.point - mesh.vertices[v]).squaredNorm() > way.squaredNorm()) {
           ++refused_here;
@@ -61,6 +72,7 @@ long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const Rel
         }
         points[v] = p.point;
         cells[v] = p.cell;
+        moved[v] = 1;
       }
       refused += refused_here;
     });
@@ -68,7 +80,7 @@ long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const Rel
     mesh.cells.swap(cells);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t v = r.begin(); v != r.end(); ++v)
-        mesh.normals[v] = complex.evaluate(mesh.vertices[v], mesh.cells[v]).gradient.normalized();
+        if (moved[v]) mesh.normals[v] = complex.evaluate(mesh.vertices[v], mesh.cells[v]).gradient.normalized();
     });
   }
   return refused.load();

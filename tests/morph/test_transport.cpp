@@ -229,6 +229,28 @@ TEST_CASE("tangential relaxation keeps a transported frame on the skin and mends
   CHECK(f.mesh.triangles == transported.triangles);
 }
 
+// A vertex already near the centroid of its neighbours is settled: it
+// stays, with no projection (RelaxationOptions::settled_below).
+TEST_CASE("tangential relaxation leaves settled vertices where they are", "[morph]") {
+  const TransportedFrame f = transported_2k39_frame();
+  const size_t n = f.mesh.vertices.size();
+  auto unmoved = [&](double settled_below) {
+    SurfaceMesh mesh = f.mesh;
+    RelaxationOptions options;
+    options.settled_below = settled_below;
+    relax_tangentially(f.to, mesh, options);
+    size_t count = 0;
+    for (size_t v = 0; v < n; ++v) count += mesh.vertices[v] == f.mesh.vertices[v];
+    return count;
+  };
+  CHECK(unmoved(1e9) == n);  // every vertex settled
+  const size_t settled = unmoved(RelaxationOptions{}.settled_below);
+  INFO(settled << " of " << n << " vertices unmoved by default");
+  CHECK(settled > 0);
+  CHECK(settled < n / 2);
+  CHECK(unmoved(0.0) < settled);
+}
+
 TEST_CASE("tangential relaxation gives the same points with one thread as with several", "[morph]") {
   TransportedFrame f = transported_2k39_frame();
   SurfaceMesh one = f.mesh, many = f.mesh;
