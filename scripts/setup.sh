@@ -17,6 +17,7 @@ packages=(
   libtbb-dev                                        # threads
   libcli11-dev                                      # command line
   nlohmann-json3-dev                                # JSON reports
+  robin-map-dev                                     # flat hash map (the morph's mesh edits)
 )
 
 source "$here/scripts/install-packages.sh"
