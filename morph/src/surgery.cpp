@@ -13,9 +13,9 @@
 #include <deque>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 
 #include <tsl/robin_map.h>
-#include <utility>
 
 namespace skinmesh::detail {
 namespace {

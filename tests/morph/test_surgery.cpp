@@ -14,7 +14,7 @@ using namespace skinmesh;
 
 TEST_CASE("edits: thinning skips an edge refused in the frame before until it shrinks or its refusal ages",
           "[morph]") {
-  const std::vector<Ball> balls = test::centred_model(std::string(SKINMESH_DATA_DIR) + "/pept.pdb", 1);
+  const std::vector<Ball> balls = test::centred_model(test::data_file("pept.pdb"), 1);
   const SkinComplex complex = build_skin_complex(balls);
   // Meshed at the mesher's 30 degrees and judged at the frames' 20: the
   // refinement leaves edges under half the target length, most of which
