@@ -326,15 +326,18 @@ struct Attempt {
 // component (no triangles yet), interior to the patch.
 Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
                   const std::vector<char>& region, size_t seeds_from, const MeshingOptions& repair,
-                  const MeshingOptions& accept, double crowded_below) {
+                  const MeshingOptions& accept, const LocalRepairOptions& options) {
   Attempt a;
   std::vector<signed char> role = vertex_roles(mesh, stars, region);
   for (size_t v = seeds_from; v < role.size(); ++v) role[v] = static_cast<signed char>(PatchRole::interior);
   add_nearby_context(mesh, region, role);
-  const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, crowded_below);
+  const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, options.crowded_below);
   std::vector<PatchRole> roles;
   std::vector<int> index;
   const std::vector<SkinSample> samples = patch_samples(mesh, role, drop, roles, index);
+  // Nearly the whole frame: no faults, so the caller remeshes it whole.
+  if (static_cast<double>(samples.size()) > options.max_sample_share * static_cast<double>(mesh.vertices.size()))
+    return a;
   const PatchMeshResult patch = mesh_patch(complex, samples, roles, repair);
   if (patch.status != MeshingStatus::ok) return a;  // no faults: growing would not help
   a.merged.vertices = mesh.vertices;
@@ -437,7 +440,7 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given,
   mark_near_changes(mesh, options.changes, region);
   region = grow_region(mesh, stars, std::move(region), options.rings);
   for (int attempt = 0; attempt < options.attempts; ++attempt) {
-    Attempt a = try_patch(complex, mesh, stars, region, given.vertices.size(), repair, accept, options.crowded_below);
+    Attempt a = try_patch(complex, mesh, stars, region, given.vertices.size(), repair, accept, options);
     if (a.ok) {
       if (!topology_as_expected(given, a.merged, options)) return out;
       out.patch_triangles = std::count(region.begin(), region.end(), 1);

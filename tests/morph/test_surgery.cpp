@@ -1,11 +1,14 @@
-// The edits' thinning (morph/src/surgery.hpp, private to morph/): an edge
-// whose contraction was refused is not tried again in the next frame unless
-// it has shrunk or its refusal has aged.
+// The morph's repair stages on their own, through their private headers
+// (morph/src/surgery.hpp, local_repair.hpp): the edits' thinning, where an
+// edge whose contraction was refused is not tried again in the next frame
+// unless it has shrunk or its refusal has aged; and the local repair, which
+// leaves a patch that is nearly the whole frame to the whole-frame remesh.
 #include <catch2/catch.hpp>
 
 #include "test_support.hpp"
 
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "local_repair.hpp"
 #include "surgery.hpp"
 
 #include <numeric>
@@ -64,4 +67,21 @@ TEST_CASE("edits: thinning skips an edge refused in the frame before until it sh
     const detail::Surgery plain = detail::mend_by_edits(complex, made.mesh, none_failing, accept, options);
     CHECK(plain.thin_tried == first.thin_tried);
   }
+}
+
+TEST_CASE("local repair: a patch that would take nearly every vertex is left to the whole-frame remesh", "[morph]") {
+  const std::vector<Ball> balls = test::centred_model(test::data_file("pept.pdb"), 1);
+  const SkinComplex complex = build_skin_complex(balls);
+  const SkinMeshResult made = mesh_skin(complex, MeshingOptions{});
+  REQUIRE(made.status == MeshingStatus::ok);
+  MeshingOptions accept;
+  accept.min_angle = 20;
+  const std::vector<char> all_failing(made.mesh.triangles.size(), 1);  // the patch is the whole mesh
+  detail::LocalRepairOptions options;
+  const detail::LocalRepair refused = detail::repair_locally(complex, made.mesh, all_failing, MeshingOptions{}, accept, options);
+  CHECK_FALSE(refused.ok);
+  options.max_sample_share = 2;  // no bound: the same patch is meshed
+  const detail::LocalRepair meshed = detail::repair_locally(complex, made.mesh, all_failing, MeshingOptions{}, accept, options);
+  CHECK(meshed.ok);
+  CHECK(meshed.patch_triangles == static_cast<long>(made.mesh.triangles.size()));
 }
