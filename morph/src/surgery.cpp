@@ -375,8 +375,9 @@ void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<
       if (a > b) continue;  // each edge once
       const double limit = options_.thin_below * std::min(target[static_cast<size_t>(a)], target[static_cast<size_t>(b)]);
       const double length = (at(a) - at(b)).norm();
+      if (!(length < limit)) continue;
       const auto key = key_of(a, b);
-      if (!(length < limit) || still_refused(key, length)) continue;
+      if (still_refused(key, length)) continue;
       touched.clear();
       ++thin_tried_;
       if (!contract(b, a, touched) && !contract(a, b, touched)) {

@@ -15,23 +15,39 @@
 
 using namespace skinmesh;
 
+namespace {
+
+// pept's skin meshed at the mesher's 30 degrees, to be judged at the frames'
+// 20: the refinement leaves edges under half the target length, most of
+// which cannot go without a triangle failing.
+struct PeptFrame {
+  SkinComplex complex;
+  SurfaceMesh mesh;
+  MeshingOptions accept;
+};
+
+PeptFrame pept_frame() {
+  PeptFrame f{build_skin_complex(test::centred_model(test::data_file("pept.pdb"), 1)), {}, {}};
+  SkinMeshResult made = mesh_skin(f.complex, MeshingOptions{});
+  REQUIRE(made.status == MeshingStatus::ok);
+  f.mesh = std::move(made.mesh);
+  f.accept.min_angle = 20;
+  return f;
+}
+
+}  // namespace
+
 TEST_CASE("edits: thinning skips an edge refused in the frame before until it shrinks or its refusal ages",
           "[morph]") {
-  const std::vector<Ball> balls = test::centred_model(test::data_file("pept.pdb"), 1);
-  const SkinComplex complex = build_skin_complex(balls);
-  // Meshed at the mesher's 30 degrees and judged at the frames' 20: the
-  // refinement leaves edges under half the target length, most of which
-  // cannot go without a triangle failing.
-  const SkinMeshResult made = mesh_skin(complex, MeshingOptions{});
-  REQUIRE(made.status == MeshingStatus::ok);
-  MeshingOptions accept;
-  accept.min_angle = 20;
-  std::vector<long> ids(made.mesh.vertices.size());
+  const PeptFrame f = pept_frame();
+  const SkinComplex& complex = f.complex;
+  const MeshingOptions& accept = f.accept;
+  std::vector<long> ids(f.mesh.vertices.size());
   std::iota(ids.begin(), ids.end(), 100);
-  const std::vector<char> none_failing(made.mesh.triangles.size(), 0);
+  const std::vector<char> none_failing(f.mesh.triangles.size(), 0);
   const detail::SurgeryOptions options;
   auto thin = [&](detail::RefusedEdges& refused) {
-    return detail::mend_by_edits(complex, made.mesh, none_failing, accept, options, &ids, &refused);
+    return detail::mend_by_edits(complex, f.mesh, none_failing, accept, options, &ids, &refused);
   };
 
   detail::RefusedEdges refused;
@@ -64,24 +80,19 @@ TEST_CASE("edits: thinning skips an edge refused in the frame before until it sh
     CHECK(thin(refused).thin_tried == first.thin_tried);
   }
   SECTION("without ids every short edge is tried") {
-    const detail::Surgery plain = detail::mend_by_edits(complex, made.mesh, none_failing, accept, options);
+    const detail::Surgery plain = detail::mend_by_edits(complex, f.mesh, none_failing, accept, options);
     CHECK(plain.thin_tried == first.thin_tried);
   }
 }
 
 TEST_CASE("local repair: a patch that would take nearly every vertex is left to the whole-frame remesh", "[morph]") {
-  const std::vector<Ball> balls = test::centred_model(test::data_file("pept.pdb"), 1);
-  const SkinComplex complex = build_skin_complex(balls);
-  const SkinMeshResult made = mesh_skin(complex, MeshingOptions{});
-  REQUIRE(made.status == MeshingStatus::ok);
-  MeshingOptions accept;
-  accept.min_angle = 20;
-  const std::vector<char> all_failing(made.mesh.triangles.size(), 1);  // the patch is the whole mesh
+  const PeptFrame f = pept_frame();
+  const std::vector<char> all_failing(f.mesh.triangles.size(), 1);  // the patch is the whole mesh
   detail::LocalRepairOptions options;
-  const detail::LocalRepair refused = detail::repair_locally(complex, made.mesh, all_failing, MeshingOptions{}, accept, options);
-  CHECK_FALSE(refused.ok);
+  auto repair = [&] { return detail::repair_locally(f.complex, f.mesh, all_failing, MeshingOptions{}, f.accept, options); };
+  CHECK_FALSE(repair().ok);
   options.max_sample_share = 2;  // no bound: the same patch is meshed
-  const detail::LocalRepair meshed = detail::repair_locally(complex, made.mesh, all_failing, MeshingOptions{}, accept, options);
+  const detail::LocalRepair meshed = repair();
   CHECK(meshed.ok);
-  CHECK(meshed.patch_triangles == static_cast<long>(made.mesh.triangles.size()));
+  CHECK(meshed.patch_triangles == static_cast<long>(f.mesh.triangles.size()));
 }
