@@ -44,12 +44,61 @@ bool clearly_not_flat(const Mat& g) {
   }
 }
 
+// The geometry of a simplex that is not flat from E's columns, the edges
+// from the first ball: 2 <z - z_0, e_j> = rhs_j with z - z_0 = E a. Solved
+// through the normal equations (E^T E) a = rhs / 2, the error grows with the
+// square of E's condition: a tetrahedron of 1ubi -> 1hpv whose target side is
+// nearly flat had its size 1e-8 A^2 off at every t, and the morph's frame at
+// t = 0.99 a vertex 2.6e-8 A off the skin by the morph oracle, B(t)'s exact
+// orthosphere (GMP) and CGAL's skin sign (bench/morph_precision). Here it
+// grows with the condition itself: with E = QR (thin), R^T (R a) = rhs / 2,
+// so z - z_0 = Q R^-T rhs / 2, P = Q Q^T and the affine coordinates are
+// R^-1 Q^T. A tetrahedron's E is square: z - z_0 = E^-T rhs / 2, P = I and
+// the affine coordinates E^-1 (Householder QR for it made 2k39 model 1 -> 3
+// 8% slower a frame).
+void set_geometry(MixedCell& cell, const Ball& b0, const Eigen::Vector3d& offset) {
+  cell.center = b0.center + offset;
+  cell.R2 = offset.squaredNorm() - b0.weight;
+}
+
+void solve_not_flat(MixedCell& cell, const Ball& b0, const Eigen::Matrix3d& E, const Eigen::Vector3d& rhs) {
+  const Eigen::Matrix3d inverse = E.partialPivLu().inverse();
+  set_geometry(cell, b0, 0.5 * (inverse.transpose() * rhs));
+  cell.P.setIdentity();
+  cell.to_affine = inverse;
+}
+
+void solve_not_flat(MixedCell& cell, const Ball& b0, const Eigen::Matrix<double, 3, 2>& E, const Eigen::Vector2d& rhs) {
+  // Thin QR by Gram-Schmidt: q0 along e0, q1 the rest of e1.
+  const double r00 = E.col(0).norm();
+  const Eigen::Vector3d q0 = E.col(0) / r00;
+  const double r01 = q0.dot(E.col(1));
+  const Eigen::Vector3d rest = E.col(1) - r01 * q0;
+  const double r11 = rest.norm();
+  const Eigen::Vector3d q1 = rest / r11;
+  // R^T y = rhs / 2, forward.
+  const double y0 = 0.5 * rhs[0] / r00;
+  const double y1 = (0.5 * rhs[1] - r01 * y0) / r11;
+  set_geometry(cell, b0, y0 * q0 + y1 * q1);
+  cell.P = q0 * q0.transpose() + q1 * q1.transpose();
+  // R^-1 Q^T, backward.
+  cell.to_affine.row(1) = q1.transpose() / r11;
+  cell.to_affine.row(0) = (q0.transpose() - r01 * cell.to_affine.row(1)) / r00;
+}
+
+void solve_not_flat(MixedCell& cell, const Ball& b0, const Eigen::Matrix<double, 3, 1>& E,
+                    const Eigen::Matrix<double, 1, 1>& rhs) {
+  const double length2 = E.squaredNorm();
+  set_geometry(cell, b0, (0.5 * rhs[0] / length2) * E);
+  cell.P = E * E.transpose() / length2;
+  cell.to_affine.row(0) = E.transpose() / length2;
+}
+
 // Centre z_X (equal power to every ball of X within aff(delta_X)), size R2 and
 // the projector onto the directions of aff(delta_X) (docs/math.md section 3),
 // for a simplex of D+1 balls. Fixed-size matrices: a morph moves its complex
 // every frame, and with matrices of dynamic size (at most 3) this was a
-// fifth of a frame of 2k39 model 1 -> 3 (perf). The inverse is LU's, as
-// Eigen's dynamic-size inverse is, not the closed-form cofactors.
+// fifth of a frame of 2k39 model 1 -> 3 (perf).
 template <int D>
 void simplex_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
   using Mat = Eigen::Matrix<double, D, D>;
@@ -64,24 +113,18 @@ void simplex_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
     rhs[j] = E.col(j).squaredNorm() - bj.weight + b0.weight;
   }
   const Mat gram = E.transpose() * E;
-  Mat gram_inv;
-  if (clearly_not_flat(gram)) {
-    gram_inv = gram.partialPivLu().inverse();
-  } else if (const Vec values = Eigen::SelfAdjointEigenSolver<Mat>(gram, Eigen::EigenvaluesOnly).eigenvalues();
-             values.minCoeff() > 1e-14 * values.maxCoeff()) {
-    gram_inv = gram.partialPivLu().inverse();
-  } else {
-    const double largest = values.maxCoeff();
-    // Affinely dependent vertices (a flat simplex from cospherical input):
-    // pseudo-inverse on the span that exists.
-    cell.degenerate = true;
-    const Eigen::SelfAdjointEigenSolver<Mat> eig(gram);
-    Vec inv = eig.eigenvalues();
-    for (int i = 0; i < D; ++i) inv[i] = inv[i] > 1e-14 * largest ? 1.0 / inv[i] : 0.0;
-    gram_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
-  }
-  const Vec a = 0.5 * gram_inv * rhs;
-  const Eigen::Vector3d offset = E * a;
+  if (clearly_not_flat(gram)) return solve_not_flat(cell, b0, E, rhs);
+  const Eigen::SelfAdjointEigenSolver<Mat> eig(gram);
+  const Vec values = eig.eigenvalues();
+  const double largest = values.maxCoeff();
+  if (values.minCoeff() > 1e-14 * largest) return solve_not_flat(cell, b0, E, rhs);
+  // Affinely dependent vertices (a flat simplex from cospherical input):
+  // pseudo-inverse on the span that exists.
+  cell.degenerate = true;
+  Vec inv = values;
+  for (int i = 0; i < D; ++i) inv[i] = inv[i] > 1e-14 * largest ? 1.0 / inv[i] : 0.0;
+  const Mat gram_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  const Eigen::Vector3d offset = E * (0.5 * gram_inv * rhs);
   cell.center = b0.center + offset;
   cell.R2 = offset.squaredNorm() - b0.weight;
   cell.P = E * gram_inv * E.transpose();
