@@ -11,6 +11,7 @@
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/number_text.hpp"
+#include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/mesh_io/mesh_write.hpp"
@@ -21,7 +22,7 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -140,8 +141,8 @@ Sides read_sides(const MorphCommandOptions& o) {
 // What is measured of each frame before it is written.
 struct FrameCheck {
   MeshQuality quality;
-  double max_error = 0;   // morph oracle distance of the vertices, Angstrom
-  long uncertified = 0;
+  double max_error = 0;   // distance of the vertices to the skin of B(t), Angstrom (see check_frame)
+  long uncertified = 0;   // vertices the morph oracle could not certify
   double share_below_bound = 0;  // of the triangles, those whose smallest angle is under the bound
   bool holds = false;
 };
@@ -161,31 +162,64 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees) {
   return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
 }
 
-FrameCheck check_frame(const SurfaceMesh& mesh, const MorphOracle& oracle, double t, double min_angle,
+// What a frame is measured against: the morph oracle and, where it cannot
+// certify, the complex of B(t)'s balls built from scratch.
+struct FrameReference {
+  const MorphOracle& oracle;
+  const Morph& morph;
+  const std::vector<Ball>& source;
+  const std::vector<Ball>& target;
+  double shrink;
+  // The balls of B(t) as a static set: the ends' own balls, the live pairs' in between.
+  std::vector<Ball> balls_at(double t) const {
+    if (t == 0.0) return source;
+    if (t == 1.0) return target;
+    return interpolated_balls(source, target, morph.pairs(), t);
+  }
+};
+
+// Each vertex's distance to the skin of B(t) by the morph oracle, which
+// knows neither the morph's complex nor its live pairs. Very near an end
+// the oracle may not certify a point (on 2k39 model 1 -> 3, centred, two
+// vertices of the frame at t = 0.9999 with a KKT gap of 3e-6 and a distance
+// of 4.3e-6 A, where B(t)'s own complex put them 7.5e-17 and 4.9e-16 A off
+// and the overlay complex as close): those vertices are measured instead on
+// the complex of B(t)'s balls built from scratch (a regular triangulation,
+// not the morph's overlay), and counted in `uncertified`.
+double largest_error(const SurfaceMesh& mesh, const FrameReference& reference, double t, long& uncertified) {
+  std::vector<double> off(mesh.vertices.size());
+  std::vector<char> certified(mesh.vertices.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const MorphOracleResult e = reference.oracle.evaluate(mesh.vertices[v], t);
+      off[v] = e.distance();
+      certified[v] = e.certified;
+    }
+  });
+  uncertified = std::count(certified.begin(), certified.end(), 0);
+  if (uncertified > 0) {
+    const SkinComplex own = build_skin_complex(reference.balls_at(t), {reference.shrink});
+    for (size_t v = 0; v < off.size(); ++v)
+      if (!certified[v]) {
+        const SkinEval e = own.evaluate(mesh.vertices[v]);
+        const double g = e.gradient.norm();
+        off[v] = g > 0 ? std::abs(e.value) / g : INFINITY;
+      }
+  }
+  return off.empty() ? 0.0 : *std::max_element(off.begin(), off.end());
+}
+
+FrameCheck check_frame(const SurfaceMesh& mesh, const FrameReference& reference, double t, double min_angle,
                        bool self_intersections) {
   FrameCheck c;
   GradeOptions grade;
   grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
   c.quality = grade_mesh(mesh, grade);
-  using Worst = std::pair<double, long>;
-  const Worst worst = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, mesh.vertices.size(), 256), Worst{0.0, 0},
-      [&](const tbb::blocked_range<size_t>& r, Worst w) {
-        for (size_t v = r.begin(); v != r.end(); ++v) {
-          const MorphOracleResult e = oracle.evaluate(mesh.vertices[v], t);
-          w.first = std::max(w.first, e.distance());
-          w.second += !e.certified;
-        }
-        return w;
-      },
-      [](Worst a, Worst b) { return Worst{std::max(a.first, b.first), a.second + b.second}; });
-  c.max_error = worst.first;
-  c.uncertified = worst.second;
+  c.max_error = largest_error(mesh, reference, t, c.uncertified);
   c.share_below_bound = share_below(mesh, min_angle);
   const MeshQuality& q = c.quality;
   c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
-            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
-            c.uncertified == 0;
+            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8;
   return c;
 }
 
@@ -208,6 +242,7 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"full_rebuild", s.full_rebuild},
           {"events", s.events},
           {"max_onsurf_error", c.max_error},
+          {"oracle_uncertified", c.uncertified},
           {"components", q.components},
           {"euler", q.euler},
           {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
@@ -360,11 +395,12 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   OutputSet outputs;
   const MorphOracle oracle(sides.source_balls, sides.target_balls, o.molecule.shrink);
   Morph morph = prepare_morph(sides.source_balls, sides.target_balls, times.front(), options);
+  const FrameReference reference{oracle, morph, sides.source_balls, sides.target_balls, o.molecule.shrink};
   std::ostringstream lines;
   long repairs = 0, rebuilds = 0, repaired = 0;
   for (size_t k = 0; k < times.size(); ++k) {
     const MorphFrame& f = k == 0 ? morph.frame() : morph.advance_to(times[k]);
-    const FrameCheck check = check_frame(f.mesh, oracle, times[k], options.frames.min_angle, !o.no_self_intersections);
+    const FrameCheck check = check_frame(f.mesh, reference, times[k], options.frames.min_angle, !o.no_self_intersections);
     json line = frame_json(f.stats, check, frame_name(k, o.formats.front()));
     if (!check.holds) {
       if (progress) std::cerr << "\n";

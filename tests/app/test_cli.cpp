@@ -410,7 +410,7 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
     const auto j = nlohmann::json::parse(line);
     for (const char* key : {"t", "file", "vertices", "triangles", "min_angle", "share_below_bound", "moved",
                             "relocated", "inserted", "removed", "repairs", "full_rebuild", "max_onsurf_error",
-                            "components", "euler", "seconds"})
+                            "oracle_uncertified", "components", "euler", "seconds"})
       CHECK(j.contains(key));
     CHECK(j["min_angle"].get<double>() >= 20.0);
     CHECK(j["max_onsurf_error"].get<double>() <= 1e-8);
@@ -451,6 +451,30 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   CHECK(backwards.output.find("increase") != std::string::npos);
   std::ifstream none(second + "/morph.json");
   CHECK_FALSE(none.good());
+  std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
+// At t = 0.9999 on 2k39 model 1 -> 3 (centroid, no Kabsch fit) the morph
+// oracle leaves a vertex or two uncertified (a KKT gap of 3e-6, its distance
+// 4.3e-6 A), and the command refused a frame that is on the skin. Those
+// vertices are measured on B(t)'s own complex instead (cmd_morph.cpp,
+// check_frame), and counted.
+TEST_CASE("skinmesh morph near t = 1: vertices the oracle cannot certify are measured on B(t)'s own complex",
+          "[cli][morph]") {
+  char pattern[] = "/tmp/skinmesh-morph-end-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = std::string(pattern) + "/out";
+  const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
+  const Run r = run("--quiet morph " + file + " " + file +
+                    " --source-model 1 --target-model 3 --align centroid --t 0.9999 -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  std::ifstream jsonl(dir + "/frames.jsonl");
+  std::string line;
+  REQUIRE(std::getline(jsonl, line));
+  const auto j = nlohmann::json::parse(line);
+  CHECK(j["oracle_uncertified"].get<long>() >= 1);  // the case this test is about still arises
+  CHECK(j["max_onsurf_error"].get<double>() <= 1e-8);
   std::system(("rm -rf " + std::string(pattern)).c_str());
 }
 
