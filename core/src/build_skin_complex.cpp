@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <tuple>
 #include <cmath>
 #include <string>
@@ -338,21 +339,39 @@ struct SkinComplexBuilder {
     for (int i : live) sc.grid_balls_[static_cast<size_t>(cursor[bucket_of(i)]++)] = i;
   }
 
-  // `out` = `from` with its balls moved; copy-assigned, so that a complex
-  // moved before keeps its allocations.
-  static void moved(const SkinComplex& from, std::vector<Ball> balls, SkinComplex& out) {
+  // `out` = `from` with its balls moved, each cell listed in `known` (by
+  // ascending cell) taking its centre and size from there and its projector
+  // from `from`. Copy-assigned, so that a complex moved before keeps its
+  // allocations; not even copied when `out` holds `from`'s combinatorics
+  // already (a morph's frames): the copy of 2k39 model 1 -> 3's cells,
+  // cofaces and tuple map was a third of moving its complex.
+  static void moved(const SkinComplex& from, std::vector<Ball> balls, const std::vector<SkinComplex::KnownCell>& known,
+                    SkinComplex& out) {
     if (balls.size() != from.balls_.size()) contract_error("with_balls: the number of balls differs from the complex's");
     if (&out == &from) contract_error("with_balls: the complex cannot be moved onto itself");
     check_finite(balls);
-    out = from;
+    for (size_t k = 0; k < known.size(); ++k)
+      if (known[k].cell < 0 || known[k].cell >= static_cast<int>(from.cells_.size()) ||
+          (k > 0 && known[k].cell <= known[k - 1].cell))
+        contract_error("with_balls: known cells must be in range and ascending");
+    if (out.combinatorics_ != from.combinatorics_ || out.cells_.size() != from.cells_.size()) out = from;
     out.balls_ = std::move(balls);
     // Each cell on its own, on every core: a morph moves the complex every
     // frame, and serially this was a tenth of a frame (pept -> 3al1: 15 ms
-    // of 0.14 s; 1ubi -> 1hpv 120 ms).
+    // of 0.14 s; 1ubi -> 1hpv 120 ms). Every field of the geometry is
+    // written, so a cell's earlier frame leaves nothing behind.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, out.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t c = r.begin(); c != r.end(); ++c) {
         out.cells_[c].degenerate = false;
         compute_cell_geometry(out.cells_[c], out.balls_);
+      }
+    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, known.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t k = r.begin(); k != r.end(); ++k) {
+        MixedCell& cell = out.cells_[static_cast<size_t>(known[k].cell)];
+        cell.center = known[k].center;
+        cell.R2 = known[k].R2;
+        cell.P = from.cells_[static_cast<size_t>(known[k].cell)].P;
       }
     });
     build_start_grid(out);
@@ -371,6 +390,8 @@ struct SkinComplexBuilder {
                           static_cast<int>(i));
     }
     const Regular rt(points.begin(), points.end());
+    static std::atomic<unsigned long> builds{0};
+    sc.combinatorics_ = ++builds;
     sc.dimension_ = rt.dimension();
     add_simplices(rt, sc);
     link_faces(sc);
@@ -386,7 +407,7 @@ struct SkinComplexBuilder {
 
 SkinComplex SkinComplex::with_balls(std::vector<Ball> balls) const {
   SkinComplex sc;
-  SkinComplexBuilder::moved(*this, std::move(balls), sc);
+  SkinComplexBuilder::moved(*this, std::move(balls), {}, sc);
   return sc;
 }
 
@@ -397,14 +418,7 @@ SkinComplex SkinComplex::with_balls(std::vector<Ball> balls, const std::vector<K
 }
 
 void SkinComplex::with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known, SkinComplex& out) const {
-  SkinComplexBuilder::moved(*this, std::move(balls), out);
-  for (const KnownCell& k : known) {
-    if (k.cell < 0 || k.cell >= static_cast<int>(cells_.size())) contract_error("with_balls: a known cell out of range");
-    MixedCell& cell = out.cells_[static_cast<size_t>(k.cell)];
-    cell.center = k.center;
-    cell.R2 = k.R2;
-    cell.P = cells_[static_cast<size_t>(k.cell)].P;
-  }
+  SkinComplexBuilder::moved(*this, std::move(balls), known, out);
 }
 
 bool SkinComplex::same_flat_cells(const SkinComplex& other) const {

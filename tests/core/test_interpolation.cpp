@@ -125,6 +125,11 @@ TEST_CASE("with_balls with known cells: those take the given centre and size and
   CHECK_THROWS_AS(middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{-1, centre, 0.0}}), ContractError);
   const int past = static_cast<int>(middle.cells().size());
   CHECK_THROWS_AS(middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{past, centre, 0.0}}), ContractError);
+  // Listed out of order (or twice), a cell could be written by two threads.
+  CHECK_THROWS_AS(middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{other, centre, 0.0}, {edge, centre, 0.0}}),
+                  ContractError);
+  CHECK_THROWS_AS(middle.with_balls(interpolated_balls(m1, m2, live, 0.3), {{edge, centre, 0.0}, {edge, centre, 0.0}}),
+                  ContractError);
 }
 
 TEST_CASE("with_balls into a complex moved before: every cell and ball as a fresh move makes them", "[interpolation]") {
@@ -136,7 +141,8 @@ TEST_CASE("with_balls into a complex moved before: every cell and ball as a fres
   while (middle.cell(edge).dim != 1) ++edge;
   const std::vector<SkinComplex::KnownCell> known{{edge, Eigen::Vector3d(0.5, 1.0, -1.0), 0.25}};
   // The storage of another complex (the source's own, other cells) and of a
-  // frame moved before: neither may leave anything behind.
+  // frame moved before (at t = 0.7 only the geometry is written, the
+  // combinatorics being the same): neither may leave anything behind.
   SkinComplex reused = build_skin_complex(m1, {0.5});
   for (double t : {0.2, 0.7}) {
     middle.with_balls(interpolated_balls(m1, m2, live, t), known, reused);

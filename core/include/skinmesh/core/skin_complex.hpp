@@ -120,7 +120,8 @@ class SkinComplex {
   // every t in (0,1), whose centre is affine and whose size is quadratic in
   // t (docs/math.md section 4). Near t = 0 or 1 such a cell is a sliver, and
   // its geometry recomputed from its balls lost up to ~1e-8 A of the skin.
-  // Throws ContractError for a cell index out of range.
+  // Throws ContractError for a cell index out of range or cells not listed
+  // in ascending order.
   struct KnownCell {
     int cell = -1;
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
@@ -129,7 +130,10 @@ class SkinComplex {
   SkinComplex with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known) const;
   // The same, written over `out`, whose storage is reused: a morph moves its
   // complex every frame, and a fresh copy of pept -> 3al1's 41,000 cells took
-  // 6 of the 15 ms that moving it took. `out` must not be this complex.
+  // 6 of the 15 ms that moving it took. When `out` was itself moved from a
+  // complex of the same build (the morph's two frames in turn), only the
+  // balls and the geometry are written: cells, faces, cofaces and the tuple
+  // lookup are the same. `out` must not be this complex.
   void with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known, SkinComplex& out) const;
   // Whether two complexes of one combinatorics have the same flat cells
   // (MixedCell::degenerate): a frame whose flat cells differ from the complex
@@ -204,6 +208,9 @@ class SkinComplex {
   double grid_step_ = 1.0;
   std::array<int, 3> grid_size_{{1, 1, 1}};
   std::vector<int> grid_offset_, grid_balls_;
+  // Which build the cells, faces and cofaces come from (copied with them):
+  // with_balls onto a complex of the same build rewrites only the geometry.
+  unsigned long combinatorics_ = 0;
 };
 
 // Throws ContractError on an empty or non-finite ball set or a shrink
