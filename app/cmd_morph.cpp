@@ -399,7 +399,8 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   std::ostringstream lines;
   long repairs = 0, rebuilds = 0, repaired = 0;
   for (size_t k = 0; k < times.size(); ++k) {
-    const MorphFrame& f = k == 0 ? morph.frame() : morph.advance_to(times[k]);
+    const MorphFrame& f =
+        k == 0 ? morph.frame() : morph.advance_to(times[k], k + 1 < times.size() ? times[k + 1] : -1);
     const FrameCheck check = check_frame(f.mesh, reference, times[k], options.frames.min_angle, !o.no_self_intersections);
     json line = frame_json(f.stats, check, frame_name(k, o.formats.front()));
     if (!check.holds) {

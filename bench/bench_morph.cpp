@@ -87,7 +87,7 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
   c.seconds += c.seconds_first;
   c.grade(morph.frame().mesh, oracle, ts.front());
   for (size_t k = 1; k < ts.size(); ++k) {
-    const MorphFrame& f = morph.advance_to(ts[k]);
+    const MorphFrame& f = morph.advance_to(ts[k], k + 1 < ts.size() ? ts[k + 1] : -1);
     c.seconds += f.stats.seconds;
     c.seconds_repair += f.stats.seconds_repair;
     c.repaired += f.stats.repaired;

@@ -40,6 +40,7 @@
 #include "skinmesh/morph/relaxation.hpp"
 
 #include <array>
+#include <functional>
 #include <map>
 #include <utility>
 #include <vector>
@@ -139,7 +140,12 @@ class Morph {
   // t = 0) the overlay degenerates to the target's (source's) complex, so the
   // vertices are projected onto the other complex's skin and the frame is
   // remeshed from them.
-  const MorphFrame& advance_to(double t);
+  //
+  // `next_t`, when given (in (t, 1)), is the frame that will be asked for
+  // after this one: its complex is then moved while this frame is repaired,
+  // on the core the mostly serial repairs leave idle, and advance_to(next_t)
+  // starts from it. The frames are the same either way.
+  const MorphFrame& advance_to(double t, double next_t = -1);
   double t() const { return t_; }
   // Per vertex of the current frame: the source atom and the target atom it
   // belongs to (the pair of the cell's ball of least power distance, the
@@ -175,12 +181,24 @@ class Morph {
   void reseat(const SkinComplex& next, FrameStats& stats);
   SkinComplex overlay_at(double t) const;
   void overlay_at(double t, SkinComplex& out) const;  // into out's storage (see with_balls)
+  std::vector<SkinComplex::KnownCell> known_cells(double t) const;  // the overlay cells' centres and sizes at t
   void finish_frame(double t, Clock::time_point start);
+  bool vanishing_left(double t, const std::vector<char>& handled) const;
+  // A frame after transport, relaxation and judging, before its repair.
+  struct Transported {
+    SurfaceMesh mesh;
+    std::vector<char> failing;        // per triangle
+    std::vector<char> drop;           // per vertex: lost (removed at a whole-frame remesh)
+    std::vector<char> handled;        // per event: its vanishing component was dropped (drop_vanished)
+    long first_new_id = 0, before = 0;  // the first id this frame may give; vertices of the frame before
+  };
+  void mend_frame(const SkinComplex& next, double t, Transported& moved, const std::function<void()>& before_remesh);
 
   std::vector<Ball> source_, target_;
   std::vector<BallPair> pairs_;
   SkinComplex middle_, current_;
   SkinComplex spare_;  // the complex of the frame before last: storage for the next frame's
+  double spare_t_ = -1;  // the frame spare_ was moved to ahead (advance_to's next_t); -1: none
   bool on_overlay_ = true;  // current_ is the overlay complex (cells numbered as middle_)
   MorphOptions options_;
   std::vector<CellSize> sizes_;  // per cell of middle_: its size and centre as functions of t
