@@ -344,7 +344,7 @@ struct SkinComplexBuilder {
   // from `from`. Copy-assigned, so that a complex moved before keeps its
   // allocations; not even copied when `out` holds `from`'s combinatorics
   // already (a morph's frames): the copy of 2k39 model 1 -> 3's cells,
-  // cofaces and tuple map was a third of moving its complex.
+  // cofaces and tuple map was about half of moving its complex (2.3 ms).
   static void moved(const SkinComplex& from, std::vector<Ball> balls, const std::vector<SkinComplex::KnownCell>& known,
                     SkinComplex& out) {
     if (balls.size() != from.balls_.size()) contract_error("with_balls: the number of balls differs from the complex's");

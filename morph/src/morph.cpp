@@ -353,16 +353,17 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
   frame_.stats = stats;
   // While the frame is mended by edits or a patch, mostly on one core, the
   // next frame's complex is moved on the other into current_, which
-  // transport no longer needs: 2k39 model 1 -> 3 took 0.0092 s a frame
-  // instead of 0.0101 (a probe over 100 frames). It is waited for before a
-  // whole-frame remesh, which runs partly on both cores: overlapping that
-  // too saved 1-2% of a frame of 3al1 -> 1ubi and raised its peak memory
-  // from 175 to 208 MB (glibc's heap for the other thread). The cell list
-  // and balls are made on this thread for the same reason.
-  tbb::task_group lookahead;
+  // transport no longer needs: 2k39 model 1 -> 3 took 0.0093-0.0095 s a
+  // frame instead of 0.0101-0.0102 (a probe over 100 frames). It is waited
+  // for before a whole-frame remesh, which runs partly on both cores:
+  // overlapping that too saved 1-2% of a frame of 3al1 -> 1ubi and raised
+  // its peak memory from 175 to 208 MB (glibc's heap for the other
+  // thread). The cell list and balls are made on this thread for the same
+  // reason.
   const bool ahead = next_t > t && next_t < 1 && stats.lost == 0 && !vanishing_left(t, moved.handled);
   std::vector<SkinComplex::KnownCell> known;
   std::vector<Ball> balls;
+  tbb::task_group lookahead;  // after what its task reads: if the repair throws, it waits before they go
   if (ahead) {
     known = known_cells(next_t);
     balls = interpolated_balls(source_, target_, pairs_, next_t);

@@ -144,7 +144,9 @@ class Morph {
   // `next_t`, when given (in (t, 1)), is the frame that will be asked for
   // after this one: its complex is then moved while this frame is repaired,
   // on the core the mostly serial repairs leave idle, and advance_to(next_t)
-  // starts from it. The frames are the same either way.
+  // starts from it. The frames are the same either way. A Morph whose
+  // advance_to threw (a frame the mesher could not make: Error) holds no
+  // valid frame and is not to be advanced again.
   const MorphFrame& advance_to(double t, double next_t = -1);
   double t() const { return t_; }
   // Per vertex of the current frame: the source atom and the target atom it
