@@ -247,6 +247,10 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"euler", q.euler},
           {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
           {"seconds", s.seconds},
+          {"seconds_complex", s.seconds_complex},
+          {"seconds_transport", s.seconds_transport},
+          {"seconds_relax", s.seconds_relax},
+          {"seconds_judge", s.seconds_judge},
           {"seconds_repair", s.seconds_repair}};
 }
 

@@ -45,6 +45,8 @@ constexpr double kShrink = 0.5;
 // One column's frames, accumulated; raw bytes through the child's pipe.
 struct Column {
   double frames = 0, seconds = 0, seconds_first = 0, seconds_repair = 0;
+  // (c) only: where the later frames' time went (FrameStats), summed.
+  double seconds_complex = 0, seconds_transport = 0, seconds_relax = 0, seconds_judge = 0;
   double triangles = 0, below_20 = 0, min_angle = 180;
   double max_error = 0, uncertified = 0;
   double invalid_frames = 0;  // not closed, manifold and oriented, or self-intersecting
@@ -90,6 +92,10 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
     const MorphFrame& f = morph.advance_to(ts[k], k + 1 < ts.size() ? ts[k + 1] : -1);
     c.seconds += f.stats.seconds;
     c.seconds_repair += f.stats.seconds_repair;
+    c.seconds_complex += f.stats.seconds_complex;
+    c.seconds_transport += f.stats.seconds_transport;
+    c.seconds_relax += f.stats.seconds_relax;
+    c.seconds_judge += f.stats.seconds_judge;
     c.repaired += f.stats.repaired;
     c.remeshed += f.stats.remeshed;
     c.full_rebuilds += f.stats.full_rebuild;
@@ -140,6 +146,10 @@ struct Row {
   bench::Forked<Column> run;
 };
 
+// Milliseconds per frame after the first (the morph's stage times; zero for
+// the rebuild columns, which have no later frames of their own).
+double later_ms(const Column& c, double seconds) { return c.frames > 1 ? 1e3 * seconds / (c.frames - 1) : 0.0; }
+
 void print_json(const Row& r, const Pair& p) {
   const Column& c = r.run.result;
   const double n = std::max(1.0, c.frames);
@@ -149,17 +159,47 @@ void print_json(const Row& r, const Pair& p) {
       "\"seconds_repair_per_frame\": %.4f, \"peak_mb\": %.1f, \"mean_triangles\": %.0f, \"min_angle\": %.3f, "
       "\"share_below_20\": %.6f, \"max_on_surface_error\": %.3e, \"uncertified\": %.0f, \"invalid_frames\": %.0f, "
       "\"repaired_frames\": %.0f, \"remeshed_frames\": %.0f, \"full_rebuilds\": %.0f, \"inserted_per_frame\": %.1f, "
-      "\"removed_per_frame\": %.1f, \"relocated_per_frame\": %.1f, \"mean_vertices\": %.0f}\n",
+      "\"removed_per_frame\": %.1f, \"relocated_per_frame\": %.1f, \"mean_vertices\": %.0f, "
+      "\"later_frame_ms\": {\"complex\": %.3f, \"transport\": %.3f, \"relax\": %.3f, \"judge\": %.3f, "
+      "\"repair\": %.3f, \"whole\": %.3f}}\n",
       r.pair.c_str(), p.source.size(), p.target.size(), p.alignment.c_str(), r.column.c_str(),
       r.run.status.c_str(), c.frames, c.seconds / n, c.seconds_first, c.seconds_repair / n, r.run.peak_mb,
       c.triangles / n, c.min_angle, c.below_20 / std::max(1.0, c.triangles), c.max_error, c.uncertified,
       c.invalid_frames, c.repaired, c.remeshed, c.full_rebuilds, c.inserted / n, c.removed / n, c.relocated / n,
-      c.vertices / n);
+      c.vertices / n, later_ms(c, c.seconds_complex), later_ms(c, c.seconds_transport),
+      later_ms(c, c.seconds_relax), later_ms(c, c.seconds_judge), later_ms(c, c.seconds_repair),
+      later_ms(c, c.seconds - c.seconds_first));
   std::fflush(stdout);
 }
 
 double per_frame(const Row* r) {
   return r && r->run.status == "ok" ? r->run.result.seconds / std::max(1.0, r->run.result.frames) : NAN;
+}
+
+// Where a later frame of (c) goes, and what a/c and b/c could be at most if
+// every repair were free: transport and judging run on every frame before any
+// repair (the "transport every vertex, watch every triangle"), and
+// relaxation, without which far more triangles fail (docs/morph.md).
+void print_stage_table(const std::vector<Row>& rows) {
+  // other: the wait for the complex moved ahead (advance_to's next_t) and the bookkeeping between stages.
+  std::printf("\n| pair | c ms/frame | complex | transport | relax | judge | repair | other | a/c, free repairs | "
+              "b/c, free repairs | b/c, free repairs and relaxation |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const Row& r : rows) {
+    if (r.column != "c morph" || r.run.status != "ok") continue;
+    const Row *a = nullptr, *b = nullptr;
+    for (const Row& other : rows)
+      if (other.pair == r.pair) {
+        if (other.column.rfind("a ", 0) == 0) a = &other;
+        if (other.column.rfind("b ", 0) == 0) b = &other;
+      }
+    const Column& c = r.run.result;
+    const double watch = later_ms(c, c.seconds_transport + c.seconds_judge), relax = later_ms(c, c.seconds_relax);
+    const double a_ms = 1e3 * per_frame(a), b_ms = 1e3 * per_frame(b), whole = later_ms(c, c.seconds - c.seconds_first);
+    const double complex = later_ms(c, c.seconds_complex), repair = later_ms(c, c.seconds_repair);
+    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %.1f | %.1f |\n", r.pair.c_str(),
+                whole, complex, later_ms(c, c.seconds_transport), relax, later_ms(c, c.seconds_judge), repair,
+                whole - complex - watch - relax - repair, a_ms / (watch + relax), b_ms / (watch + relax), b_ms / watch);
+  }
 }
 
 void print_table(const std::vector<Row>& rows, int timeout) {
@@ -190,6 +230,7 @@ void print_table(const std::vector<Row>& rows, int timeout) {
     const double c = per_frame(&rows[i]);
     std::printf("| %s | %.1f | %.1f |\n", rows[i].pair.c_str(), per_frame(a) / c, per_frame(b) / c);
   }
+  print_stage_table(rows);
 }
 
 }  // namespace

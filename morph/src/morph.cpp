@@ -229,6 +229,7 @@ bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std:
 // t = 1, the overlay after a first frame at t = 0), then the frame remeshed
 // from them: the cells of the two complexes are not the same cells.
 void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
+  const auto transport_start = Clock::now();
   SurfaceMesh moved = frame_.mesh;
   std::vector<char> lost(moved.vertices.size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, lost.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
@@ -243,6 +244,7 @@ void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
   });
   stats.lost = std::count(lost.begin(), lost.end(), 1);
   stats.relocated = static_cast<long>(lost.size()) - stats.lost;
+  stats.seconds_transport = seconds_since(transport_start);
   frame_.stats = stats;
   const auto repair_start = Clock::now();
   remesh_or_rebuild(next, moved, lost);
@@ -329,6 +331,7 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
                                [&](const TopologyEvent& e) { return e.t > t_ && e.t <= t; });
   if (t == 1.0 || !on_overlay_) {
     SkinComplex next = t == 1.0 ? build_skin_complex(target_, {options_.shrink}) : overlay_at(t);
+    stats.seconds_complex = seconds_since(start);
     reseat(next, stats);
     current_ = std::move(next);
     spare_t_ = -1;
@@ -337,18 +340,25 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
     return frame_;
   }
   if (spare_t_ != t) overlay_at(t, spare_);
+  stats.seconds_complex = seconds_since(start);
   const SkinComplex& next = spare_;
   Transported moved;
   moved.mesh = frame_.mesh;
   moved.first_new_id = next_id_;
   moved.before = static_cast<long>(frame_.ids.size());
   std::vector<char> stayed;
+  auto stage_start = Clock::now();
   moved.drop = move_vertices(next, moved.mesh, stats, stayed);
   moved.handled = drop_vanished(t, stayed, moved.mesh, moved.drop, stats);
+  stats.seconds_transport = seconds_since(stage_start);
   if (stats.lost == 0) {
+    stage_start = Clock::now();
     if (options_.relaxation.passes > 0) relax_tangentially(next, moved.mesh, options_.relaxation);
+    stats.seconds_relax = seconds_since(stage_start);
+    stage_start = Clock::now();
     moved.failing = detail::failing_triangles(next, moved.mesh, moved.mesh.triangles, options_.frames);
     stats.bad_triangles = std::count(moved.failing.begin(), moved.failing.end(), 1);
+    stats.seconds_judge = seconds_since(stage_start);
   }
   frame_.stats = stats;
   // While the frame is mended by edits or a patch, mostly on one core, the
@@ -467,7 +477,11 @@ Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t
                        ? morph.overlay_at(t0)
                        : build_skin_complex(morph.source_, {options.shrink});
   morph.t_ = t0;
+  const double seconds_complex = seconds_since(start);
+  const auto mesh_start = Clock::now();
   morph.rebuild(morph.current_, options.first_criteria(), t0);
+  morph.frame_.stats.seconds_complex = seconds_complex;
+  morph.frame_.stats.seconds_repair = seconds_since(mesh_start);  // meshed from scratch
   morph.frame_.stats.inserted = static_cast<long>(morph.frame_.mesh.vertices.size());
   morph.finish_frame(t0, start);
   return morph;

@@ -412,6 +412,14 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
                             "relocated", "inserted", "removed", "repairs", "full_rebuild", "max_onsurf_error",
                             "oracle_uncertified", "components", "euler", "seconds"})
       CHECK(j.contains(key));
+    // Where the frame's time went: stages that do not overlap, within the frame's seconds.
+    double stages = 0;
+    for (const char* key : {"seconds_complex", "seconds_transport", "seconds_relax", "seconds_judge", "seconds_repair"}) {
+      REQUIRE(j.contains(key));
+      CHECK(j[key].get<double>() >= 0);
+      stages += j[key].get<double>();
+    }
+    CHECK(stages <= j["seconds"].get<double>());
     CHECK(j["min_angle"].get<double>() >= 20.0);
     CHECK(j["max_onsurf_error"].get<double>() <= 1e-8);
     ++frames;

@@ -36,6 +36,23 @@ void check_ids(const std::vector<long>& before, const MorphFrame& f, std::set<lo
   seen.insert(now.begin(), now.end());
 }
 
+// Where the frame's time went: stages that do not overlap, within the
+// frame's seconds; a frame transported in the overlay was judged (and
+// relaxed, when asked), and one kept as transported was not mended.
+void check_stage_seconds(const FrameStats& s, const MorphOptions& options) {
+  const double stages = s.seconds_complex + s.seconds_transport + s.seconds_relax + s.seconds_judge + s.seconds_repair;
+  for (double part : {s.seconds_complex, s.seconds_transport, s.seconds_relax, s.seconds_judge, s.seconds_repair})
+    CHECK(part >= 0);
+  CHECK(stages <= s.seconds);
+  CHECK(s.seconds_transport > 0);
+  if (s.lost == 0) {
+    CHECK(s.seconds_judge > 0);
+    CHECK((s.seconds_relax > 0) == (options.relaxation.passes > 0));
+  }
+  if (!s.repaired && !s.full_rebuild) CHECK(s.seconds_repair == 0);
+  if (s.repaired) CHECK(s.seconds_repair > 0);
+}
+
 }  // namespace
 
 TEST_CASE("morph frames of two balls: transported until their skins join, repaired there", "[morph][frames]") {
@@ -62,6 +79,7 @@ TEST_CASE("morph frames of two balls: transported until their skins join, repair
     if (f.stats.events > 0) CHECK(f.stats.repaired);
     CHECK_FALSE(f.stats.full_rebuild);
     check_ids(before, f, seen);
+    check_stage_seconds(f.stats, options);
   }
   INFO(transported << " of 18 frames transported");
   CHECK(transported > 0);

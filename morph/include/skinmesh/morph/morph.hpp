@@ -122,8 +122,16 @@ struct FrameStats {
   long repairs = 0;            // refinement insertions, each at a failing triangle
   long split = 0, flipped = 0, contracted = 0;  // edits that mended failing triangles
   bool full_rebuild = false;   // the frame was meshed from scratch (repair failed)
-  double seconds = 0;          // the whole frame
-  double seconds_repair = 0;   // of which remeshing (or rebuilding)
+  // Where the frame's time went (seconds; docs/morph.md, "Where a frame's
+  // time goes"). The stages do not overlap; their sum falls short of
+  // `seconds` by the bookkeeping between them and by the wait for the
+  // complex moved ahead (advance_to's next_t).
+  double seconds = 0;            // the whole frame
+  double seconds_complex = 0;    // the frame's complex moved to t (0 when moved ahead during the frame before)
+  double seconds_transport = 0;  // every vertex transported or put on the new skin, vanished components dropped
+  double seconds_relax = 0;      // tangential relaxation
+  double seconds_judge = 0;      // every triangle judged against the frame's criteria
+  double seconds_repair = 0;     // mending: edits, local repair, whole-frame remesh or rebuild
 };
 
 struct MorphFrame {
