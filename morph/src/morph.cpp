@@ -22,6 +22,13 @@ namespace skinmesh {
 
 namespace {
 
+// Whether a critical event falls in the step (from, to].
+bool in_step(const TopologyEvent& e, double from, double to) { return e.t > from && e.t <= to; }
+
+// Whether it takes a whole component or void away (dimension 0 or 3,
+// lowering the Euler characteristic): drop_vanished's case.
+bool takes_a_sphere(const TopologyEvent& e) { return (e.dim == 0 || e.dim == 3) && e.euler_change < 0; }
+
 // The critical events in (from, to] as places where the local repair must
 // change the topology, with the change of the Euler characteristic they add
 // up to. A component or a void born (dimension 0 or 3, the Euler
@@ -37,9 +44,9 @@ bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::v
                           double to, const std::vector<char>& handled, detail::LocalRepairOptions& local) {
   for (size_t i = 0; i < events.size(); ++i) {
     const TopologyEvent& e = events[i];
-    if (!(e.t > from && e.t <= to) || handled[i]) continue;
+    if (!in_step(e, from, to) || handled[i]) continue;
+    if (takes_a_sphere(e)) return false;
     const bool sphere = e.dim == 0 || e.dim == 3;
-    if (sphere && e.euler_change < 0) return false;
     const CellSize& size = sizes[static_cast<size_t>(e.cell)];
     const double feature = std::sqrt(std::abs(size.at(to)));
     detail::TopologyChange change;
@@ -281,7 +288,7 @@ std::vector<char> Morph::drop_vanished(double t, const std::vector<char>& stayed
   std::vector<size_t> which;
   for (size_t i = 0; i < events_.size(); ++i) {
     const TopologyEvent& e = events_[i];
-    if (!(e.t > t_ && e.t <= t) || !(e.dim == 0 || e.dim == 3) || e.euler_change >= 0) continue;
+    if (!in_step(e, t_, t) || !takes_a_sphere(e)) continue;
     const CellSize& size = sizes_[static_cast<size_t>(e.cell)];
     spheres.push_back({size.center(t_), 1.0 + 2 * std::sqrt(std::abs(size.at(t_)))});
     which.push_back(i);
@@ -317,7 +324,7 @@ std::vector<char> Morph::drop_vanished(double t, const std::vector<char>& stayed
 bool Morph::vanishing_left(double t, const std::vector<char>& handled) const {
   for (size_t i = 0; i < events_.size(); ++i) {
     const TopologyEvent& e = events_[i];
-    if (e.t > t_ && e.t <= t && (e.dim == 0 || e.dim == 3) && e.euler_change < 0 && !handled[i]) return true;
+    if (in_step(e, t_, t) && takes_a_sphere(e) && !handled[i]) return true;
   }
   return false;
 }
@@ -328,7 +335,7 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
   FrameStats stats;
   stats.t = t;
   stats.events = std::count_if(events_.begin(), events_.end(),
-                               [&](const TopologyEvent& e) { return e.t > t_ && e.t <= t; });
+                               [&](const TopologyEvent& e) { return in_step(e, t_, t); });
   if (t == 1.0 || !on_overlay_) {
     SkinComplex next = t == 1.0 ? build_skin_complex(target_, {options_.shrink}) : overlay_at(t);
     stats.seconds_complex = seconds_since(start);
