@@ -4,6 +4,7 @@
 // is written, into a self-describing directory (docs/morph.md).
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "morph_frames.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
@@ -13,10 +14,13 @@
 #include "skinmesh/core/number_text.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/morph/alignment.hpp"
+#include "skinmesh/morph/matched_motion.hpp"
 #include "skinmesh/morph/morph.hpp"
+#include "skinmesh/morph/moving_balls.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include <Eigen/Geometry>
@@ -45,6 +49,7 @@ struct MorphCommandOptions {
   int frames = 21;
   std::vector<double> times;  // instead of --frames
   std::string align = "auto";
+  std::string pairs = "auto";
   std::vector<std::string> formats{"ply", "vtp"};
   MorphOptions morph;
   bool no_self_intersections = false;
@@ -67,6 +72,10 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
                  "auto (Kabsch on matched atoms when both sides are the same molecule, centroid otherwise), "
                  "none, centroid or kabsch")
       ->check(CLI::IsMember({"auto", "none", "centroid", "kabsch"}))->capture_default_str();
+  cmd.add_option("--pairs", o.pairs,
+                 "matched (each atom one ball that travels, radius kept), all (the m x n blend of every source "
+                 "and target ball), or auto (matched when both sides are one molecule, as --align auto decides)")
+      ->check(CLI::IsMember({"auto", "matched", "all"}))->capture_default_str();
   cmd.add_option("--min-angle", o.morph.frames.min_angle, "smallest angle of every triangle of every frame, degrees")
       ->check(finite_number())->check(CLI::Range(1.0, 30.0))->capture_default_str();
   cmd.add_option("--epsilon", o.morph.first.sizing.epsilon, "curvature-relative size (edge / radius of curvature)")
@@ -144,23 +153,9 @@ struct FrameCheck {
   double max_error = 0;   // distance of the vertices to the skin of B(t), Angstrom (see check_frame)
   long uncertified = 0;   // vertices the morph oracle could not certify
   double share_below_bound = 0;  // of the triangles, those whose smallest angle is under the bound
+  SkinTopology skin;             // of B(t)'s balls, from their alpha complex: the frame must have it
   bool holds = false;
 };
-
-double share_below(const SurfaceMesh& mesh, double bound_degrees) {
-  long below = 0;
-  for (const auto& t : mesh.triangles) {
-    double smallest = 180;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d& p = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>(k)])];
-      const Eigen::Vector3d u = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)])] - p;
-      const Eigen::Vector3d w = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 2) % 3)])] - p;
-      smallest = std::min(smallest, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / M_PI);
-    }
-    below += smallest < bound_degrees;
-  }
-  return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
-}
 
 // What a frame is measured against: the morph oracle and, where it cannot
 // certify, the complex of B(t)'s balls built from scratch.
@@ -217,9 +212,11 @@ FrameCheck check_frame(const SurfaceMesh& mesh, const FrameReference& reference,
   c.quality = grade_mesh(mesh, grade);
   c.max_error = largest_error(mesh, reference, t, c.uncertified);
   c.share_below_bound = share_below(mesh, min_angle);
+  c.skin = skin_topology(reference.balls_at(t));
   const MeshQuality& q = c.quality;
   c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
-            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8;
+            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
+            q.components == c.skin.components && q.cavities == c.skin.voids && q.euler == c.skin.euler;
   return c;
 }
 
@@ -244,7 +241,9 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"max_onsurf_error", c.max_error},
           {"oracle_uncertified", c.uncertified},
           {"components", q.components},
+          {"voids", q.cavities},
           {"euler", q.euler},
+          {"skin_topology", {{"components", c.skin.components}, {"voids", c.skin.voids}, {"euler", c.skin.euler}}},
           {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
           {"seconds", s.seconds},
           {"seconds_complex", s.seconds_complex},
@@ -252,42 +251,6 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"seconds_relax", s.seconds_relax},
           {"seconds_judge", s.seconds_judge},
           {"seconds_repair", s.seconds_repair}};
-}
-
-// The output directory: made when missing (and removed again when the
-// command fails before anything is in it).
-class OutputDirectory {
- public:
-  explicit OutputDirectory(const std::string& path) : path_(path) {
-    std::error_code error;
-    if (fs::exists(path_, error)) {
-      if (!fs::is_directory(path_, error)) output_error(path, "exists and is not a directory");
-    } else {
-      made_ = fs::create_directory(path_, error);
-      if (!made_) output_error(path, "cannot make the output directory (" + error.message() + ")");
-      removed_on_interrupt_.emplace_back(path_.string());
-    }
-  }
-  ~OutputDirectory() {
-    std::error_code error;
-    if (made_ && !kept_ && fs::is_empty(path_, error)) fs::remove(path_, error);
-  }
-  void keep() {
-    kept_ = true;
-    removed_on_interrupt_.clear();
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-  bool made_ = false, kept_ = false;
-  std::vector<RemovedOnInterrupt> removed_on_interrupt_;  // the directory, while made and not kept
-};
-
-std::string frame_name(size_t k, const std::string& format) {
-  char name[64];
-  std::snprintf(name, sizeof name, "frame_%04zu.%s", k, format.c_str());
-  return name;
 }
 
 // The frame's mesh in every format asked for, with per-vertex patch, id and
@@ -310,15 +273,6 @@ void stage_frame(OutputSet& outputs, const OutputDirectory& dir, size_t k, const
     const MeshFormat mf = mesh_format_from_path(frame_name(k, format));
     outputs.add(dir.file(frame_name(k, format)), [&](std::ostream& out) { write_mesh(out, f.mesh, mf, &a); });
   }
-}
-
-// A VTK collection: ParaView opens it as an animation over t.
-void write_pvd(std::ostream& out, const std::vector<double>& times) {
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (size_t k = 0; k < times.size(); ++k)
-    out << "<DataSet timestep=\"" << exact_number_text(times[k]) << "\" file=\"" << frame_name(k, "vtp")
-        << "\"/>\n";
-  out << "</Collection>\n</VTKFile>\n";
 }
 
 json alignment_json(const Alignment& a, long unmoved) {
@@ -349,15 +303,6 @@ std::string stage_side(OutputSet& outputs, const OutputDirectory& dir, const std
   return name;
 }
 
-// One line on the terminal, rewritten: frames done, vertices, repairs and
-// the time left at the pace so far.
-void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed) {
-  const double left = done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0.0;
-  std::fprintf(stderr, "\rskinmesh: frame %zu/%zu  t = %.4f  %ld vertices  %ld repairs  %.0f s left   ", done, total,
-               s.t, s.vertices, repairs, left);
-  std::fflush(stderr);
-}
-
 json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& morph, const std::vector<double>& t,
                 const MorphOptions& options) {
   json events = json::array();
@@ -379,22 +324,132 @@ json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& m
           {"first_frame_min_angle", options.first.min_angle}};
 }
 
+// Which balls the morph blends, and why (docs/morph.md, "Two kinds of morph").
+struct Pairing {
+  bool matched = false;
+  std::string why;
+};
+
+Pairing choose_pairing(const MorphCommandOptions& o, const Sides& sides) {
+  if (o.pairs == "matched") return {true, "asked for (--pairs matched)"};
+  if (o.pairs == "all") return {false, "asked for (--pairs all)"};
+  if (same_molecule(sides.source, sides.target))
+    return {true, "both sides are one molecule (90% of the smaller side's atoms match by chain, residue and name): "
+                  "its atoms travel"};
+  return {false, "the sides are different molecules (under 90% of the smaller side's atoms match): the m x n blend"};
+}
+
+void print_alignment(const Sides& sides) {
+  std::cerr << "skinmesh: alignment " << alignment_method_name(sides.alignment.used)
+            << (sides.alignment.used == AlignmentMethod::kabsch
+                    ? " on " + std::to_string(sides.alignment.matched) + " matched atoms, RMSD " +
+                          std::to_string(sides.alignment.rmsd) + " A"
+                    : std::string())
+            << (sides.unmoved > 0 ? "; " + std::to_string(sides.unmoved) +
+                                        " atoms within 1e-9 A of their source atom put exactly on it"
+                                  : std::string())
+            << "\n";
+}
+
+MovingOptions moving_options(const MorphOptions& m) {
+  MovingOptions o;
+  o.shrink = m.shrink;
+  o.first = m.first;
+  o.frames = m.frames;
+  o.first_size_margin = m.first_size_margin;
+  o.relaxation = m.relaxation;
+  o.edits = m.edits;
+  o.crowded_below = m.crowded_below;
+  o.local_repair_share = m.local_repair_share;
+  return o;
+}
+
+// --pairs matched: the atoms travel (matched_motion.hpp), carried by the
+// moving-balls engine; every frame's balls are written beside it.
+ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& global, const Sides& sides,
+                           const std::vector<double>& times, const Pairing& pairing, Clock::time_point start) {
+  const bool progress = !global.quiet && !global.json;
+  const MorphOptions options = morph_options(o);
+  const MatchedMotion motion = match_motion(sides.source, sides.source_balls, sides.target, sides.target_balls);
+  MovingFrames run;
+  run.times = times;
+  run.balls_of = [&](size_t k) { return motion.balls_at(times[k]); };
+  for (const MatchedMotion::Track& track : motion.tracks) run.ball_atoms.push_back({track.source, track.target});
+  run.options = moving_options(options);
+  run.formats = o.formats;
+  run.self_intersections = !o.no_self_intersections;
+  run.progress = progress;
+  OutputDirectory dir(o.directory);
+  OutputSet outputs;
+  std::ostringstream lines;
+  const MovingFramesResult result = run_moving_frames(run, outputs, dir, lines);
+  if (!result.holds) {
+    if (progress) std::cerr << "\n";
+    std::cerr << "skinmesh: error: frame " << result.failed_index << " (t = " << times[result.failed_index]
+              << ") fails a guarantee; nothing written\n"
+              << json_text(result.failed_frame) << "\n";
+    return ExitCode::not_met;
+  }
+  json report = {{"source", o.source},
+                 {"target", o.target},
+                 {"source_model", o.source_model},
+                 {"target_model", o.target_model},
+                 {"source_atoms", sides.source_balls.size()},
+                 {"target_atoms", sides.target_balls.size()},
+                 {"shrink", o.molecule.shrink},
+                 {"weights", convention_name(o.molecule.convention())},
+                 {"pairs", "matched"},
+                 {"pairs_because", pairing.why},
+                 {"ball_sets",
+                  "one ball per atom: matched atoms (chain, residue number, insertion code, residue and atom name) on "
+                  "straight lines from source to target, radius linear between the sides' radii; an atom on one side "
+                  "only grows out of (or shrinks into) the nearest matched atom of its side, radius linear from 0 "
+                  "(docs/morph.md); frame_NNNN.wpts holds every frame's balls"},
+                 {"matched_atoms", motion.matched},
+                 {"source_only_atoms", motion.source_only},
+                 {"target_only_atoms", motion.target_only},
+                 {"alignment", alignment_json(sides.alignment, sides.unmoved)},
+                 {"frame_times", times},
+                 {"min_angle", options.frames.min_angle},
+                 {"first_frame_min_angle", options.first.min_angle},
+                 {"max_step", run.options.max_step}};
+  report["source_balls_file"] = stage_side(outputs, dir, "source", sides.source, sides.source_balls);
+  report["target_balls_file"] = stage_side(outputs, dir, "target", sides.target, sides.target_balls);
+  const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
+  if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, times); });
+  report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
+  report["frames"] = times.size();
+  report["repaired_frames"] = result.repaired;
+  report["remeshed_frames"] = result.remeshed;
+  report["full_rebuilds"] = result.rebuilt;
+  report["repairs"] = result.repairs;
+  report["min_ids_kept"] = result.min_ids_kept;
+  report["max_kept_move"] = result.max_kept_move;
+  report["seconds"] = seconds_since(start);
+  outputs.add(dir.file("frames.jsonl"), [&](std::ostream& out) { out << lines.str(); });
+  outputs.add(dir.file("morph.json"), [&](std::ostream& out) { out << json_text(report) << "\n"; });
+  outputs.commit();
+  dir.keep();
+  if (global.json) std::cout << json_text(report) << "\n";
+  else if (!global.quiet)
+    std::cout << o.directory << ": " << times.size() << " frames, matched atoms (" << pairing.why << "), "
+              << result.remeshed << " remeshed whole, " << result.rebuilt << " rebuilt from scratch, ids kept "
+              << result.min_ids_kept * 100 << "% or more a frame, " << report["seconds"].get<double>() << " s\n";
+  return ExitCode::ok;
+}
+
 ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   const std::vector<double> times = frame_times(o);
   const MorphOptions options = morph_options(o);
   const Sides sides = read_sides(o);
-  if (progress)
-    std::cerr << "skinmesh: alignment " << alignment_method_name(sides.alignment.used)
-              << (sides.alignment.used == AlignmentMethod::kabsch
-                      ? " on " + std::to_string(sides.alignment.matched) + " matched atoms, RMSD " +
-                            std::to_string(sides.alignment.rmsd) + " A"
-                      : std::string())
-              << (sides.unmoved > 0 ? "; " + std::to_string(sides.unmoved) +
-                                          " atoms within 1e-9 A of their source atom put exactly on it"
-                                    : std::string())
-              << "\n";
+  const Pairing pairing = choose_pairing(o, sides);
+  if (progress) {
+    print_alignment(sides);
+    std::cerr << "skinmesh: pairs " << (pairing.matched ? "matched" : "all") << ": " << pairing.why << "\n";
+  }
+  if (pairing.matched) return run_matched_morph(o, global, sides, times, pairing, start);
   OutputDirectory dir(o.directory);
   OutputSet outputs;
   const MorphOracle oracle(sides.source_balls, sides.target_balls, o.molecule.shrink);
@@ -422,6 +477,8 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   }
   if (progress) std::cerr << "\n";
   json report = morph_json(o, sides, morph, times, options);
+  report["pairs"] = "all";
+  report["pairs_because"] = pairing.why;
   report["source_balls_file"] = stage_side(outputs, dir, "source", sides.source, sides.source_balls);
   report["target_balls_file"] = stage_side(outputs, dir, "target", sides.target, sides.target_balls);
   const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();

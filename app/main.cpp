@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   skinmesh::app::add_volume_command(app, global, exit_code);
   skinmesh::app::add_interpolate_command(app, global, exit_code);
   skinmesh::app::add_morph_command(app, global, exit_code);
+  skinmesh::app::add_trajectory_command(app, global, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -23,8 +23,8 @@ AtomKey key_of(const Atom& a) { return {a.chain, a.residue_number, a.insertion_c
 // share of the smaller side's atoms match; otherwise the match is chance.
 constexpr double kSameMolecule = 0.9;
 
-// Pairs (source index, target index) of the atoms both have, each key once
-// (a key seen twice on a side is ambiguous and left out).
+}  // namespace
+
 std::vector<std::pair<size_t, size_t>> matched_atoms(const Molecule& source, const Molecule& target) {
   std::map<AtomKey, std::pair<int, size_t>> in_source;  // times seen, index
   for (size_t k = 0; k < source.atoms.size(); ++k) {
@@ -42,6 +42,8 @@ std::vector<std::pair<size_t, size_t>> matched_atoms(const Molecule& source, con
   }
   return pairs;
 }
+
+namespace {
 
 std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> matched_positions(const Molecule& source,
                                                                            const Molecule& target) {
@@ -93,9 +95,7 @@ Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod 
   if (method == AlignmentMethod::none) return out;
   if (method == AlignmentMethod::kabsch || method == AlignmentMethod::automatic) {
     const auto pairs = matched_positions(source, target);
-    const double smaller = static_cast<double>(std::min(source.atoms.size(), target.atoms.size()));
-    const bool same_molecule = static_cast<double>(pairs.size()) >= kSameMolecule * smaller;
-    if (pairs.size() >= 3 && (method == AlignmentMethod::kabsch || same_molecule)) return kabsch(pairs);
+    if (pairs.size() >= 3 && (method == AlignmentMethod::kabsch || same_molecule(source, target))) return kabsch(pairs);
     if (method == AlignmentMethod::kabsch)
       contract_error("Kabsch alignment needs at least three atoms matched by chain, residue and name; " +
                      std::to_string(pairs.size()) + " match");
@@ -103,6 +103,11 @@ Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod 
   out.used = AlignmentMethod::centroid;
   out.motion.translation = centroid(source.atoms) - centroid(target.atoms);
   return out;
+}
+
+bool same_molecule(const Molecule& source, const Molecule& target) {
+  const double smaller = static_cast<double>(std::min(source.atoms.size(), target.atoms.size()));
+  return static_cast<double>(matched_atoms(source, target).size()) >= kSameMolecule * smaller;
 }
 
 Molecule moved(Molecule molecule, const RigidMotion& motion) {

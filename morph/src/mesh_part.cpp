@@ -1,5 +1,11 @@
 #include "mesh_part.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <utility>
+
 namespace skinmesh::detail {
 
 SurfaceMesh used_part(const SurfaceMesh& mesh, const std::vector<char>& keep_triangle, std::vector<int>& kept_from) {
@@ -25,6 +31,32 @@ SurfaceMesh used_part(const SurfaceMesh& mesh, const std::vector<char>& keep_tri
                               renumber[static_cast<size_t>(t[2])]});
   }
   return part;
+}
+
+}  // namespace skinmesh::detail
+
+namespace skinmesh::detail {
+
+long mark_crowded(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria, double below,
+                  std::vector<char>& drop) {
+  std::vector<double> target(mesh.vertices.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, target.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      target[v] = target_edge_length(complex, mesh.vertices[v], mesh.cells[v], criteria);
+  });
+  long marked = 0;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      size_t a = static_cast<size_t>(t[static_cast<size_t>(k)]), b = static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)]);
+      if (a > b) std::swap(a, b);
+      if (drop[a] || drop[b]) continue;
+      const double limit = below * std::min(target[a], target[b]);
+      if ((mesh.vertices[a] - mesh.vertices[b]).squaredNorm() < limit * limit) {
+        drop[b] = 1;
+        ++marked;
+      }
+    }
+  return marked;
 }
 
 }  // namespace skinmesh::detail

@@ -2,7 +2,9 @@
 // repair, the edits and the dropping of vanished components keep of a mesh.
 #pragma once
 
+#include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
 
 #include <vector>
 
@@ -13,5 +15,13 @@ namespace skinmesh::detail {
 // normals, in the mesh's order. kept_from[k]: the index in `mesh` of the
 // part's vertex k.
 SurfaceMesh used_part(const SurfaceMesh& mesh, const std::vector<char>& keep_triangle, std::vector<int>& kept_from);
+
+// Before a frame is remeshed from its vertices: along every mesh edge
+// shorter than `below` times the smaller target edge length (`criteria`) at
+// its ends, the vertex with the larger index is marked in `drop` (unless
+// its partner is marked already); transport crowds vertices where a patch
+// shrinks. Returns how many were marked.
+long mark_crowded(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria, double below,
+                  std::vector<char>& drop);
 
 }  // namespace skinmesh::detail

@@ -139,30 +139,6 @@ std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mes
   return lost;
 }
 
-// Along every mesh edge shorter than crowded_below times the smaller target
-// length at its ends, the vertex with the larger index goes (unless its
-// partner goes already). Returns how many were marked in `drop`.
-long Morph::mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const {
-  std::vector<double> target(mesh.vertices.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, target.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v)
-      target[v] = target_edge_length(next, mesh.vertices[v], mesh.cells[v], options_.frames);
-  });
-  long marked = 0;
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      size_t a = static_cast<size_t>(t[static_cast<size_t>(k)]), b = static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)]);
-      if (a > b) std::swap(a, b);
-      if (drop[a] || drop[b]) continue;
-      const double limit = options_.crowded_below * std::min(target[a], target[b]);
-      if ((mesh.vertices[a] - mesh.vertices[b]).squaredNorm() < limit * limit) {
-        drop[b] = 1;
-        ++marked;
-      }
-    }
-  return marked;
-}
-
 // The failing triangles, and those around the topology changes since the
 // current frame, remeshed in patches (local_repair.hpp); false when an event
 // needs the whole frame, the seam does not hold or the topology is not what
@@ -421,7 +397,7 @@ void Morph::mend_frame(const SkinComplex& next, double t, Transported& moved,
     const bool small = left <= options_.local_repair_share * static_cast<double>(moved.failing.size());
     if (!(mendable && small && repair_locally(next, moved.mesh, moved.failing, local))) {
       before_remesh();
-      frame_.stats.crowded = mark_crowded(next, moved.mesh, moved.drop);
+      frame_.stats.crowded = detail::mark_crowded(next, moved.mesh, options_.frames, options_.crowded_below, moved.drop);
       remesh_or_rebuild(next, moved.mesh, moved.drop);
     }
   }

@@ -31,7 +31,8 @@ void vertex_neighbours(const SurfaceMesh& mesh, std::vector<int>& offsets, std::
 
 }  // namespace
 
-long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& options) {
+long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& options,
+                        const std::vector<char>* movable) {
   std::vector<int> offsets, indices;
   vertex_neighbours(mesh, offsets, indices);
   const size_t n = mesh.vertices.size();
@@ -51,7 +52,7 @@ long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const Rel
         points[v] = mesh.vertices[v];
         cells[v] = mesh.cells[v];
         const int begin = offsets[v], end = offsets[v + 1];
-        if (begin == end) continue;
+        if (begin == end || (movable && !(*movable)[v])) continue;
         Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
         double spacing = 0;  // mean distance to the neighbours
         for (int k = begin; k < end; ++k) {

@@ -3,7 +3,10 @@
 #include "test_support.hpp"
 
 #include "skinmesh/core/molecule.hpp"
+#include "skinmesh/mesh_io/mesh_read.hpp"
 #include "skinmesh/mesh_io/mesh_write.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -390,7 +393,7 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   REQUIRE(mkdtemp(pattern) != nullptr);
   const std::string dir = std::string(pattern) + "/out";
   const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
-  const Run r = run("morph " + file + " " + file + " --source-model 1 --target-model 3 --frames 4 -o " + dir);
+  const Run r = run("morph " + file + " " + file + " --source-model 1 --target-model 3 --pairs all --frames 4 -o " + dir);
   INFO(r.output);
   REQUIRE(r.code == 0);
   for (int k = 0; k < 4; ++k)
@@ -462,6 +465,118 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   std::system(("rm -rf " + std::string(pattern)).c_str());
 }
 
+// A PDB file's atoms moved by `shift` (columns 31-54 rewritten; the rest kept).
+std::string shifted_pdb(const std::string& path, const Eigen::Vector3d& shift) {
+  std::ifstream in(path);
+  std::ostringstream out;
+  std::string line;
+  while (std::getline(in, line)) {
+    if ((line.rfind("ATOM", 0) == 0 || line.rfind("HETATM", 0) == 0) && line.size() >= 54) {
+      char xyz[32];
+      std::snprintf(xyz, sizeof xyz, "%8.3f%8.3f%8.3f", std::stod(line.substr(30, 8)) + shift[0],
+                    std::stod(line.substr(38, 8)) + shift[1], std::stod(line.substr(46, 8)) + shift[2]);
+      line.replace(30, 24, xyz);
+    }
+    out << line << "\n";
+  }
+  return out.str();
+}
+
+TEST_CASE("skinmesh morph --pairs matched: a translated molecule travels rigidly, ids kept, each frame's balls written",
+          "[cli][morph][moving]") {
+  char pattern[] = "/tmp/skinmesh-matched-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string source = skinmesh::test::data_file("pept.pdb");
+  const std::string target = std::string(pattern) + "/pept-moved.pdb";
+  std::ofstream(target) << shifted_pdb(source, Eigen::Vector3d(20, 0, 0));
+  const std::string dir = std::string(pattern) + "/out";
+  const Run r = run("--quiet morph " + source + " " + target + " --align none --frames 5 -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  std::ifstream morph_json(dir + "/morph.json");
+  const auto m = nlohmann::json::parse(morph_json);
+  CHECK(m["pairs"] == "matched");  // the default for one molecule
+  CHECK(m["matched_atoms"] == 107);
+  const skinmesh::SurfaceMesh first = skinmesh::read_surface_mesh(dir + "/frame_0000.ply");
+  for (int k = 1; k < 5; ++k) {
+    const double t = k / 4.0;
+    const skinmesh::SurfaceMesh frame = skinmesh::read_surface_mesh(dir + "/frame_000" + std::to_string(k) + ".ply");
+    REQUIRE(frame.vertices.size() == first.vertices.size());
+    CHECK(frame.triangles == first.triangles);
+    double worst = 0;
+    for (size_t v = 0; v < frame.vertices.size(); ++v)
+      worst = std::max(worst, (frame.vertices[v] - first.vertices[v] - Eigen::Vector3d(20 * t, 0, 0)).norm());
+    CHECK(worst < 1e-9);
+    // The frame's balls, read back from its .wpts, carry it: every vertex on their skin.
+    const auto balls = skinmesh::balls_from_molecule(
+        skinmesh::read_molecule(dir + "/frame_000" + std::to_string(k) + ".wpts"), 0.5);
+    const skinmesh::SkinOracle oracle(balls, 0.5);
+    double off = 0;
+    for (const auto& x : frame.vertices) off = std::max(off, oracle.evaluate(x).distance());
+    CHECK(off < 1e-8);
+  }
+  std::ifstream jsonl(dir + "/frames.jsonl");
+  std::string line;
+  int frames = 0;
+  while (std::getline(jsonl, line)) {
+    const auto j = nlohmann::json::parse(line);
+    if (frames++ == 0) continue;
+    CHECK(j["ids_kept"].get<double>() == 1.0);
+    CHECK(j["repaired"] == false);
+    CHECK(j["components"] == j["skin_topology"]["components"]);
+    CHECK(j["euler"] == j["skin_topology"]["euler"]);
+  }
+  CHECK(frames == 5);
+  // --pairs all: the m x n blend, said so (on this pair it would vanish: at
+  // t = 1/2 every weight falls by 100 A^2, so the molecule onto itself).
+  const Run all = run("--quiet morph " + source + " " + source + " --pairs all --t 0.5 -o " + dir + "-all");
+  INFO(all.output);
+  REQUIRE(all.code == 0);
+  std::ifstream all_json(dir + "-all/morph.json");
+  CHECK(nlohmann::json::parse(all_json)["pairs"] == "all");
+  std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
+TEST_CASE("skinmesh trajectory: one morph through every model, each keyframe the model's own skin",
+          "[cli][morph][moving]") {
+  char pattern[] = "/tmp/skinmesh-trajectory-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = std::string(pattern) + "/out";
+  const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
+  const Run r = run("--quiet trajectory " + file + " --frames-per-step 3 -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  std::ifstream report(dir + "/trajectory.json");
+  const auto j = nlohmann::json::parse(report);
+  CHECK(j["keyframes"] == nlohmann::json({0, 3, 6}));
+  CHECK(j["frames"] == 7);
+  // Keyframe 2 (frame 6) is model 3 fitted onto model 1: its balls as written
+  // equal the model's after the fit, and the frame lies on their skin with
+  // the skin's topology.
+  const auto balls = skinmesh::balls_from_molecule(skinmesh::read_molecule(dir + "/frame_0006.wpts"), 0.5);
+  skinmesh::ReadOptions third;
+  third.model = 3;
+  CHECK(balls.size() == skinmesh::read_molecule(file, third).atoms.size());
+  const skinmesh::SurfaceMesh frame = skinmesh::read_surface_mesh(dir + "/frame_0006.ply");
+  const skinmesh::SkinOracle oracle(balls, 0.5);
+  double off = 0;
+  for (const auto& x : frame.vertices) off = std::max(off, oracle.evaluate(x).distance());
+  CHECK(off < 1e-8);
+  std::ifstream jsonl(dir + "/frames.jsonl");
+  std::string line;
+  while (std::getline(jsonl, line)) {
+    const auto f = nlohmann::json::parse(line);
+    CHECK(f["components"] == f["skin_topology"]["components"]);
+    CHECK(f["euler"] == f["skin_topology"]["euler"]);
+    CHECK(f["min_angle"].get<double>() >= 20.0);
+  }
+  // A model whose atoms differ is refused, naming the file and the model.
+  const Run one = run("--quiet trajectory " + file + " --models 2-2 -o " + dir + "-one");
+  CHECK(one.code == 2);
+  CHECK(one.output.find("at least two models") != std::string::npos);
+  std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
 // At t = 0.9999 on 2k39 model 1 -> 3 (centroid, no Kabsch fit) the morph
 // oracle leaves a vertex or two uncertified (a KKT gap of 3e-6, its distance
 // 4.3e-6 A), and the command refused a frame that is on the skin. Those
@@ -474,7 +589,7 @@ TEST_CASE("skinmesh morph near t = 1: vertices the oracle cannot certify are mea
   const std::string dir = std::string(pattern) + "/out";
   const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
   const Run r = run("--quiet morph " + file + " " + file +
-                    " --source-model 1 --target-model 3 --align centroid --t 0.9999 -o " + dir);
+                    " --source-model 1 --target-model 3 --align centroid --pairs all --t 0.9999 -o " + dir);
   INFO(r.output);
   REQUIRE(r.code == 0);
   std::ifstream jsonl(dir + "/frames.jsonl");

@@ -7,6 +7,9 @@
 
 #include <Eigen/Core>
 
+#include <utility>
+#include <vector>
+
 namespace skinmesh {
 
 enum class AlignmentMethod {
@@ -29,6 +32,16 @@ struct Alignment {
   long matched = 0;    // atoms matched by chain, residue number, insertion code, residue and atom name (Kabsch)
   double rmsd = 0.0;   // Angstrom over the matched atoms after the motion (Kabsch)
 };
+
+// Pairs (source index, target index) of the atoms both sides have, matched
+// by chain, residue number, insertion code, residue and atom name, in the
+// target's order; a key seen twice on a side is ambiguous and left out.
+std::vector<std::pair<size_t, size_t>> matched_atoms(const Molecule& source, const Molecule& target);
+
+// Whether the two sides are one molecule (two conformations): at least 90%
+// of the smaller side's atoms match. The rule AlignmentMethod::automatic
+// and the morph's default pairing use.
+bool same_molecule(const Molecule& source, const Molecule& target);
 
 // Throws ContractError for kabsch when fewer than three atoms match.
 Alignment align(const Molecule& source, const Molecule& target, AlignmentMethod method);

@@ -122,6 +122,12 @@ struct FrameStats {
   long repairs = 0;            // refinement insertions, each at a failing triangle
   long split = 0, flipped = 0, contracted = 0;  // edits that mended failing triangles
   bool full_rebuild = false;   // the frame was meshed from scratch (repair failed)
+  // Moving balls (moving_balls.hpp) only:
+  long steps = 0;              // internal steps since the frame before (each a complex built from scratch)
+  long reidentified = 0;       // vertices that moved farther than continuity allows and took a new id
+  double ids_kept = 0;         // share of the frame's vertices whose id the frame before had
+  double max_kept_move = 0;    // largest move of a vertex whose id was kept, since the frame before (Angstrom)
+  bool topology_certified = false;  // components, voids and Euler characteristic equal the skin's (skin_topology)
   // Where the frame's time went (seconds; docs/morph.md, "Where a frame's
   // time goes"). The stages do not overlap; their sum falls short of
   // `seconds` by the bookkeeping between them and by the wait for the
@@ -186,7 +192,6 @@ class Morph {
                                   std::vector<char>& lost, FrameStats& stats);
   bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
                       const detail::LocalRepairOptions& local);
-  long mark_crowded(const SkinComplex& next, const SurfaceMesh& mesh, std::vector<char>& drop) const;
 
   void reseat(const SkinComplex& next, FrameStats& stats);
   SkinComplex overlay_at(double t) const;

@@ -13,6 +13,8 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 
+#include <vector>
+
 namespace skinmesh {
 
 struct RelaxationOptions {
@@ -33,7 +35,10 @@ struct RelaxationOptions {
 // (RelaxationOptions::settled_below); its cell and normal follow.
 // A vertex whose projection does not converge, or lands farther than the
 // way to the centroid, stays. Deterministic for any number of threads.
+// With `movable` (per vertex), only the vertices marked non-zero move: the
+// moving-balls engine relaxes the corners of failing triangles alone.
 // Returns how many vertex moves were refused (counted over all passes).
-long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& options);
+long relax_tangentially(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& options,
+                        const std::vector<char>* movable = nullptr);
 
 }  // namespace skinmesh

@@ -1,0 +1,223 @@
+#include "morph_frames.hpp"
+
+#include "quality_report.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/number_text.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/skin_topology.hpp"
+#include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/mesh_io/mesh_write.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <Eigen/Geometry>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace skinmesh::app {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+OutputDirectory::OutputDirectory(const std::string& path) : path_(path) {
+  std::error_code error;
+  if (fs::exists(path_, error)) {
+    if (!fs::is_directory(path_, error)) output_error(path, "exists and is not a directory");
+  } else {
+    made_ = fs::create_directory(path_, error);
+    if (!made_) output_error(path, "cannot make the output directory (" + error.message() + ")");
+    removed_on_interrupt_.emplace_back(path_.string());
+  }
+}
+
+OutputDirectory::~OutputDirectory() {
+  std::error_code error;
+  if (made_ && !kept_ && fs::is_empty(path_, error)) fs::remove(path_, error);
+}
+
+void OutputDirectory::keep() {
+  kept_ = true;
+  removed_on_interrupt_.clear();
+}
+
+std::string frame_name(size_t k, const std::string& format) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame_%04zu.%s", k, format.c_str());
+  return name;
+}
+
+void write_pvd(std::ostream& out, const std::vector<double>& times) {
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+  for (size_t k = 0; k < times.size(); ++k)
+    out << "<DataSet timestep=\"" << exact_number_text(times[k]) << "\" file=\"" << frame_name(k, "vtp")
+        << "\"/>\n";
+  out << "</Collection>\n</VTKFile>\n";
+}
+
+double share_below(const SurfaceMesh& mesh, double bound_degrees) {
+  long below = 0;
+  for (const auto& t : mesh.triangles) {
+    double smallest = 180;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& p = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>(k)])];
+      const Eigen::Vector3d u = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)])] - p;
+      const Eigen::Vector3d w = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 2) % 3)])] - p;
+      smallest = std::min(smallest, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / M_PI);
+    }
+    below += smallest < bound_degrees;
+  }
+  return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
+}
+
+void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed) {
+  const double left = done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0.0;
+  std::fprintf(stderr, "\rskinmesh: frame %zu/%zu  t = %.4f  %ld vertices  %ld repairs  %.0f s left   ", done, total,
+               s.t, s.vertices, repairs, left);
+  std::fflush(stderr);
+}
+
+namespace {
+
+struct MovingCheck {
+  MeshQuality quality;
+  SkinTopology skin;          // of the frame's balls, from their alpha complex
+  double max_error = 0;       // by the static oracle of the frame's balls, Angstrom
+  long uncertified = 0;       // vertices the oracle could not certify (measured on the frame's complex instead)
+  double share_below_bound = 0;
+  bool holds = false;
+};
+
+MovingCheck check_moving_frame(const MovingBalls& moving, double min_angle, bool self_intersections) {
+  const SurfaceMesh& mesh = moving.frame().mesh;
+  MovingCheck c;
+  GradeOptions grade;
+  grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
+  c.quality = grade_mesh(mesh, grade);
+  c.skin = skin_topology(moving.balls());
+  const SkinOracle oracle(moving.balls(), moving.complex().shrink());
+  std::vector<double> off(mesh.vertices.size());
+  std::vector<char> certified(mesh.vertices.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, off.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const OracleResult e = oracle.evaluate(mesh.vertices[v]);
+      certified[v] = e.certified;
+      if (e.certified) {
+        off[v] = e.distance();
+      } else {  // measured on the frame's own complex, and counted
+        const SkinEval s = moving.complex().evaluate(mesh.vertices[v], mesh.cells[v]);
+        off[v] = s.gradient.norm() > 0 ? std::abs(s.value) / s.gradient.norm() : INFINITY;
+      }
+    }
+  });
+  c.uncertified = std::count(certified.begin(), certified.end(), 0);
+  c.max_error = off.empty() ? 0.0 : *std::max_element(off.begin(), off.end());
+  c.share_below_bound = share_below(mesh, min_angle);
+  const MeshQuality& q = c.quality;
+  c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
+            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
+            q.components == c.skin.components && q.cavities == c.skin.voids && q.euler == c.skin.euler;
+  return c;
+}
+
+json moving_frame_json(const FrameStats& s, const MovingCheck& c, const std::string& file) {
+  const MeshQuality& q = c.quality;
+  return {{"t", s.t},
+          {"file", file},
+          {"vertices", s.vertices},
+          {"triangles", s.triangles},
+          {"min_angle", q.min_angle},
+          {"share_below_bound", c.share_below_bound},
+          {"steps", s.steps},
+          {"moved", s.moved},
+          {"relocated", s.relocated},
+          {"reidentified", s.reidentified},
+          {"ids_kept", s.ids_kept},
+          {"max_kept_move", s.max_kept_move},
+          {"inserted", s.inserted},
+          {"removed", s.removed},
+          {"repairs", s.repairs},
+          {"edits", {{"split", s.split}, {"flipped", s.flipped}, {"contracted", s.contracted}}},
+          {"bad_triangles_after_transport", s.bad_triangles},
+          {"repaired", s.repaired},
+          {"remeshed", s.remeshed},
+          {"full_rebuild", s.full_rebuild},
+          {"max_onsurf_error", c.max_error},
+          {"oracle_uncertified", c.uncertified},
+          {"components", q.components},
+          {"voids", q.cavities},
+          {"euler", q.euler},
+          {"skin_topology", {{"components", c.skin.components}, {"voids", c.skin.voids}, {"euler", c.skin.euler}}},
+          {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
+          {"seconds", s.seconds},
+          {"seconds_complex", s.seconds_complex},
+          {"seconds_transport", s.seconds_transport},
+          {"seconds_relax", s.seconds_relax},
+          {"seconds_judge", s.seconds_judge},
+          {"seconds_repair", s.seconds_repair}};
+}
+
+// The frame's mesh in every format asked for, with per vertex its patch
+// type, id, owning ball, and that ball's source and target atoms ("atom"
+// is the ball's index: the line of the frame's .wpts); and its balls.
+void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, size_t k, const MovingBalls& moving,
+                        const MovingFrames& run) {
+  const MorphFrame& f = moving.frame();
+  const std::vector<int> owner = moving.vertex_balls();
+  VertexAttributes a;
+  std::vector<int> ids, source_atoms, target_atoms;
+  for (size_t v = 0; v < f.mesh.vertices.size(); ++v) {
+    a.patch.push_back(moving.complex().cell(f.mesh.cells[v]).dim);
+    a.atom.push_back(owner[v]);
+    ids.push_back(static_cast<int>(f.ids[v]));
+    source_atoms.push_back(run.ball_atoms[static_cast<size_t>(owner[v])][0]);
+    target_atoms.push_back(run.ball_atoms[static_cast<size_t>(owner[v])][1]);
+  }
+  a.more = {{"id", ids}, {"source_atom", source_atoms}, {"target_atom", target_atoms}};
+  for (const std::string& format : run.formats) {
+    const MeshFormat mf = mesh_format_from_path(frame_name(k, format));
+    outputs.add(dir.file(frame_name(k, format)), [&](std::ostream& out) { write_mesh(out, f.mesh, mf, &a); });
+  }
+  outputs.add(dir.file(frame_name(k, "wpts")), [&](std::ostream& out) {
+    write_wpts(out, moving.balls(), "the balls of " + frame_name(k, run.formats.front()) + " (t = " +
+                                        exact_number_text(f.stats.t) + ")");
+  });
+}
+
+}  // namespace
+
+MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs, const OutputDirectory& dir,
+                                     std::ostream& lines) {
+  const auto start = Clock::now();
+  MovingFramesResult result;
+  MovingBalls moving(run.balls_of(0), run.options, run.times.front());
+  for (size_t k = 0; k < run.times.size(); ++k) {
+    const MorphFrame& f = k == 0 ? moving.frame() : moving.advance_to(run.balls_of(k), run.times[k]);
+    const MovingCheck check = check_moving_frame(moving, run.options.frames.min_angle, run.self_intersections);
+    const json line = moving_frame_json(f.stats, check, frame_name(k, run.formats.front()));
+    if (!check.holds) {
+      result.failed_frame = line;
+      result.failed_index = k;
+      return result;
+    }
+    stage_moving_frame(outputs, dir, k, moving, run);
+    lines << json_text(line, JsonLayout::one_line) << "\n";
+    result.repairs += f.stats.repairs;
+    if (k > 0) {
+      result.repaired += f.stats.repaired;
+      result.remeshed += f.stats.remeshed;
+      result.rebuilt += f.stats.full_rebuild;
+      result.min_ids_kept = std::min(result.min_ids_kept, f.stats.ids_kept);
+      result.max_kept_move = std::max(result.max_kept_move, f.stats.max_kept_move);
+    }
+    if (run.progress) print_progress(k + 1, run.times.size(), f.stats, result.repairs, seconds_since(start));
+  }
+  if (run.progress) std::fprintf(stderr, "\n");
+  result.holds = true;
+  return result;
+}
+
+}  // namespace skinmesh::app

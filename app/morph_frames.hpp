@@ -1,0 +1,81 @@
+// What the commands that write a directory of frames share (morph,
+// trajectory): the directory, the frame files' names, the ParaView
+// collection, progress, and the frame loop of moving balls
+// (morph/moving_balls.hpp), each frame checked before anything is written.
+#pragma once
+
+#include "output_file.hpp"
+
+#include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/morph/morph.hpp"
+#include "skinmesh/morph/moving_balls.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace skinmesh::app {
+
+// The output directory: made when missing (and removed again when the
+// command fails before anything is in it).
+class OutputDirectory {
+ public:
+  explicit OutputDirectory(const std::string& path);
+  ~OutputDirectory();
+  OutputDirectory(const OutputDirectory&) = delete;
+  OutputDirectory& operator=(const OutputDirectory&) = delete;
+  void keep();
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+  bool made_ = false, kept_ = false;
+  std::vector<RemovedOnInterrupt> removed_on_interrupt_;  // the directory, while made and not kept
+};
+
+std::string frame_name(size_t k, const std::string& format);  // frame_0007.ply
+// A VTK collection: ParaView opens it as an animation over t.
+void write_pvd(std::ostream& out, const std::vector<double>& times);
+// The share of the triangles whose smallest angle is under the bound (degrees).
+double share_below(const SurfaceMesh& mesh, double bound_degrees);
+// One line on the terminal, rewritten: frames done, vertices, repairs and
+// the time left at the pace so far.
+void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed);
+
+// A run of moving balls to write: frame k holds balls_of(k), recorded at times[k].
+struct MovingFrames {
+  std::vector<double> times;
+  std::function<std::vector<Ball>(size_t)> balls_of;
+  // Per ball: its atom on the source side and on the target side (-1 where
+  // that side lacks it), written per vertex as source_atom and target_atom.
+  std::vector<std::array<int, 2>> ball_atoms;
+  MovingOptions options;
+  std::vector<std::string> formats;  // mesh formats per frame
+  bool self_intersections = true;    // the exact check on every frame
+  bool progress = false;             // a progress line on stderr
+};
+
+struct MovingFramesResult {
+  bool holds = false;           // every frame passed its checks (otherwise nothing is staged)
+  nlohmann::json failed_frame;  // the frame that did not, as its frames.jsonl line
+  size_t failed_index = 0;
+  long repaired = 0, remeshed = 0, rebuilt = 0, repairs = 0;
+  double min_ids_kept = 1, max_kept_move = 0;  // over the frames after the first
+};
+
+// Every frame made, checked (the angle bound, closed oriented manifold
+// without self-intersections, every vertex within 1e-8 A of the skin of the
+// frame's balls by the static oracle, components, voids and Euler
+// characteristic equal to skin_topology's of those balls) and staged into
+// `outputs` with its balls (frame_NNNN.wpts); `lines` gets frames.jsonl.
+// Stops at the first frame that fails.
+MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs, const OutputDirectory& dir,
+                                     std::ostream& lines);
+
+}  // namespace skinmesh::app

@@ -1,0 +1,237 @@
+// Moving atoms (`--pairs matched`, morph/moving_balls.hpp) against per-frame
+// reconstruction, side by side in one run, each column in its own forked
+// child:
+//   (b) each frame rebuilt from scratch by skinmesh's mesher from the moved
+//       atoms (complex and mesh, at the frame criteria: 20 degrees);
+//   (c) the moving-balls engine: the first frame meshed, every later frame
+//       carried from the one before.
+// Motions: a hinge of 3mht (3,211 atoms: the residues from 200 on turned by
+// 30 degrees about an axis through residue 199's CA), and 2k39 model 1 -> 3
+// (fitted by Kabsch), each over N frames (default 101) on straight lines.
+// (b) costs about the same at every frame and averages a sample spread over
+// the run. Quality is measured with the clock stopped: every frame graded
+// (closed, manifold, oriented, self-intersections, angles) and every vertex
+// measured by the static oracle of the frame's balls.
+//
+//   bench_moving [--frames N] [--sample K] [--timeout S]
+#include "forked.hpp"
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/alignment.hpp"
+#include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <string>
+#include <vector>
+
+using namespace skinmesh;
+
+namespace {
+
+constexpr double kShrink = 0.5;
+
+std::string data(const std::string& name) { return std::string(SKINMESH_DATA_DIR) + "/" + name; }
+
+// A motion: the balls at s in [0,1].
+struct Motion {
+  std::string name;
+  size_t atoms = 0;
+  std::function<std::vector<Ball>(double)> at;
+};
+
+Motion hinge_3mht() {
+  const Molecule m = read_molecule(data("3mht.pdb"));
+  const std::vector<Ball> start = balls_from_molecule(m, kShrink);
+  std::vector<char> moving(m.atoms.size(), 0);
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < m.atoms.size(); ++i) {
+    moving[i] = m.atoms[i].residue_number >= 200;
+    if (m.atoms[i].residue_number == 199 && m.atoms[i].name == "CA") pivot = m.atoms[i].position;
+  }
+  return {"3mht hinge 30 deg", start.size(), [=](double s) {
+            const Eigen::Matrix3d turn =
+                Eigen::AngleAxisd(s * 30 * M_PI / 180, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+            std::vector<Ball> balls = start;
+            for (size_t i = 0; i < balls.size(); ++i)
+              if (moving[i]) balls[i].center = pivot + turn * (start[i].center - pivot);
+            return balls;
+          }};
+}
+
+Motion models_2k39() {
+  ReadOptions read;
+  const Molecule first = read_molecule(data("2k39_3models.pdb"), read);
+  read.model = 3;
+  Molecule third = read_molecule(data("2k39_3models.pdb"), read);
+  third = moved(std::move(third), align(first, third, AlignmentMethod::kabsch).motion);
+  const std::vector<Ball> a = balls_from_molecule(first, kShrink), b = balls_from_molecule(third, kShrink);
+  return {"2k39 model 1 -> 3", a.size(), [=](double s) {
+            if (s == 1) return b;
+            std::vector<Ball> balls = a;
+            for (size_t i = 0; i < balls.size(); ++i) balls[i].center = (1 - s) * a[i].center + s * b[i].center;
+            return balls;
+          }};
+}
+
+struct Column {
+  double frames = 0, seconds = 0, seconds_first = 0;
+  double seconds_complex = 0, seconds_transport = 0, seconds_relax = 0, seconds_judge = 0, seconds_repair = 0;
+  double triangles = 0, min_angle = 180, max_error = 0, invalid_frames = 0;
+  double remeshed = 0, full_rebuilds = 0, steps = 0, min_ids_kept = 1, mean_ids_kept = 0, max_kept_move = 0;
+  double max_atom_move = 0;
+
+  void grade(const SurfaceMesh& mesh, const std::vector<Ball>& balls) {
+    const MeshQuality q = grade_mesh(mesh);
+    frames += 1;
+    triangles += static_cast<double>(q.triangles);
+    min_angle = std::min(min_angle, q.min_angle);
+    invalid_frames += !(q.closed && q.manifold && q.oriented && q.self_intersecting_pairs == 0);
+    const SkinOracle oracle(balls, kShrink);
+    for (const Eigen::Vector3d& v : mesh.vertices) max_error = std::max(max_error, oracle.evaluate(v).distance());
+  }
+};
+
+double s_of(int k, int frames) { return static_cast<double>(k) / (frames - 1); }
+
+Column run_engine(const Motion& motion, int frames) {
+  Column c;
+  std::vector<Ball> before = motion.at(0);
+  const auto start = Clock::now();
+  MovingBalls moving(before);
+  c.seconds_first = seconds_since(start);
+  c.seconds += c.seconds_first;
+  c.grade(moving.frame().mesh, before);
+  for (int k = 1; k < frames; ++k) {
+    const std::vector<Ball> balls = motion.at(s_of(k, frames));
+    for (size_t i = 0; i < balls.size(); ++i) c.max_atom_move = std::max(c.max_atom_move, (balls[i].center - before[i].center).norm());
+    const MorphFrame& f = moving.advance_to(balls, s_of(k, frames));
+    const FrameStats& s = f.stats;
+    c.seconds += s.seconds;
+    c.seconds_complex += s.seconds_complex;
+    c.seconds_transport += s.seconds_transport;
+    c.seconds_relax += s.seconds_relax;
+    c.seconds_judge += s.seconds_judge;
+    c.seconds_repair += s.seconds_repair;
+    c.remeshed += s.remeshed;
+    c.full_rebuilds += s.full_rebuild;
+    c.steps += static_cast<double>(s.steps);
+    c.min_ids_kept = std::min(c.min_ids_kept, s.ids_kept);
+    c.mean_ids_kept += s.ids_kept / (frames - 1);
+    c.max_kept_move = std::max(c.max_kept_move, s.max_kept_move);
+    c.grade(f.mesh, balls);
+    before = balls;
+  }
+  return c;
+}
+
+Column run_rebuilds(const Motion& motion, int frames, int sample) {
+  Column c;
+  MeshingOptions criteria;
+  criteria.min_angle = 20;
+  for (int j = 0; j < sample; ++j) {
+    const double s = s_of(1 + j * (frames - 2) / std::max(1, sample - 1), frames);
+    const std::vector<Ball> balls = motion.at(s);
+    const auto start = Clock::now();
+    const SkinMeshResult made = mesh_skin(build_skin_complex(balls, {kShrink}), criteria);
+    c.seconds += seconds_since(start);
+    if (made.status != MeshingStatus::ok) throw std::runtime_error(made.message);
+    c.full_rebuilds += 1;
+    c.grade(made.mesh, balls);
+  }
+  return c;
+}
+
+struct Row {
+  std::string motion, column;
+  size_t atoms = 0;
+  bench::Forked<Column> run;
+};
+
+double later_ms(const Column& c, double seconds) { return c.frames > 1 ? 1e3 * seconds / (c.frames - 1) : 0.0; }
+
+// Seconds a frame: (b) its mean; (c) the later frames' mean (the first is a rebuild).
+double per_frame(const Row& r) {
+  const Column& c = r.run.result;
+  return r.column[0] == 'c' ? (c.seconds - c.seconds_first) / std::max(1.0, c.frames - 1)
+                            : c.seconds / std::max(1.0, c.frames);
+}
+
+void print_json(const Row& r) {
+  const Column& c = r.run.result;
+  std::printf(
+      "{\"motion\": \"%s\", \"atoms\": %zu, \"column\": \"%s\", \"status\": \"%s\", \"frames\": %.0f, "
+      "\"seconds_per_frame\": %.4f, \"seconds_first_frame\": %.3f, \"peak_mb\": %.1f, \"mean_triangles\": %.0f, "
+      "\"min_angle\": %.3f, \"max_on_surface_error\": %.3e, \"invalid_frames\": %.0f, \"remeshed_frames\": %.0f, "
+      "\"full_rebuilds\": %.0f, \"steps\": %.0f, \"min_ids_kept\": %.4f, \"mean_ids_kept\": %.4f, "
+      "\"max_kept_move\": %.3f, \"max_atom_move_per_frame\": %.3f, \"later_frame_ms\": {\"complex\": %.3f, "
+      "\"transport\": %.3f, \"relax\": %.3f, \"judge\": %.3f, \"repair\": %.3f}}\n",
+      r.motion.c_str(), r.atoms, r.column.c_str(), r.run.status.c_str(), c.frames, per_frame(r), c.seconds_first,
+      r.run.peak_mb, c.triangles / std::max(1.0, c.frames), c.min_angle, c.max_error, c.invalid_frames, c.remeshed,
+      c.full_rebuilds, c.steps, c.min_ids_kept, c.mean_ids_kept, c.max_kept_move, c.max_atom_move,
+      later_ms(c, c.seconds_complex), later_ms(c, c.seconds_transport), later_ms(c, c.seconds_relax),
+      later_ms(c, c.seconds_judge), later_ms(c, c.seconds_repair));
+  std::fflush(stdout);
+}
+
+void print_table(const std::vector<Row>& rows) {
+  std::printf("\n| motion | column | frames | s/frame | b/c | peak MB | triangles | min angle | max error A | "
+              "invalid | remeshed | ids kept min / mean | largest kept move A |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const Row& r : rows) {
+    const Column& c = r.run.result;
+    if (r.run.status != "ok") {
+      std::printf("| %s | %s | %s | | | | | | | | | | |\n", r.motion.c_str(), r.column.c_str(), r.run.status.c_str());
+      continue;
+    }
+    double ratio = NAN;
+    for (const Row& b : rows)
+      if (b.motion == r.motion && b.column[0] == 'b' && r.column[0] == 'c' && b.run.status == "ok")
+        ratio = per_frame(b) / per_frame(r);
+    std::printf("| %s | %s | %.0f | %.4f | %.1f | %.0f | %.0f | %.2f | %.1e | %.0f | %.0f | %.3f / %.3f | %.2f |\n",
+                r.motion.c_str(), r.column.c_str(), c.frames, per_frame(r), ratio, r.run.peak_mb,
+                c.triangles / std::max(1.0, c.frames), c.min_angle, c.max_error, c.invalid_frames, c.remeshed,
+                c.min_ids_kept, c.mean_ids_kept, c.max_kept_move);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int frames = 101, sample = 5, timeout = 3600;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
+    else if (a == "--sample" && i + 1 < argc) sample = std::atoi(argv[++i]);
+    else if (a == "--timeout" && i + 1 < argc) timeout = std::atoi(argv[++i]);
+    else {
+      std::fprintf(stderr, "usage: bench_moving [--frames N] [--sample K] [--timeout S]\n");
+      return 2;
+    }
+  }
+  if (frames < 3 || sample < 1) {
+    std::fprintf(stderr, "bench_moving: --frames must be at least 3 and --sample at least 1\n");
+    return 2;
+  }
+  std::vector<Row> rows;
+  for (const Motion& motion : {models_2k39(), hinge_3mht()}) {
+    Row b{motion.name, "b rebuild (skinmesh mesher)", motion.atoms,
+          bench::run_forked<Column>(timeout, [&] { return run_rebuilds(motion, frames, sample); })};
+    print_json(b);
+    rows.push_back(b);
+    Row c{motion.name, "c moving balls", motion.atoms,
+          bench::run_forked<Column>(timeout, [&] { return run_engine(motion, frames); })};
+    print_json(c);
+    rows.push_back(c);
+  }
+  print_table(rows);
+  return 0;
+}

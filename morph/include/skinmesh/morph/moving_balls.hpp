@@ -1,0 +1,115 @@
+// One molecule whose atoms move (docs/math.md section 6): the skin of a
+// ball set whose centres (and, for atoms that appear or vanish, weights)
+// change from call to call, its quality mesh carried along with vertex ids
+// that mean a continuous motion. This is the engine of a matched morph
+// (`skinmesh morph --pairs matched`), of `skinmesh trajectory` and of any
+// caller that feeds coordinates frame by frame.
+//
+// The regular triangulation of moving balls changes combinatorially, so
+// there is no fixed complex as in the m x n morph: every internal step
+// builds the complex of its balls from scratch (exact predicates, CGAL) and
+// a vertex keeps its mixed cell by the cell's ball tuple X
+// (SkinComplex::find_cell). In a cell that persists, a vertex moves by the
+// cell's exact map between its two quadrics: translate z_X, turn the
+// direction space of delta_X onto its new place, scale by
+// sqrt(R2_X(t1) / R2_X(t0)); where the cell is gone, turned flat or its
+// size changed sign, the vertex is projected onto the new skin.
+//
+// Then, cheapest first: triangles failing the frame criteria have their
+// corners relaxed along the skin, are mended by edits (split, flip,
+// contraction), then by a local patch; a frame whose topology changed or
+// that still fails is remeshed whole from its vertices, and meshed from
+// scratch only when that fails. Every step's mesh is certified: its
+// components, voids and Euler characteristic must equal those of the skin
+// of the step's balls counted from their weighted alpha complex
+// (skin_topology.hpp), independently of the mesh; a step that cannot be
+// certified throws Error.
+#pragma once
+
+#include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_topology.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/morph.hpp"
+#include "skinmesh/morph/relaxation.hpp"
+
+#include <map>
+#include <utility>
+#include <vector>
+
+namespace skinmesh {
+
+namespace detail {
+struct VanishingSphere;  // vanishing.hpp (private to morph/)
+}  // namespace detail
+
+struct MovingOptions {
+  double shrink = 0.5;    // s in (0,1)
+  MeshingOptions first;   // the first frame's mesh (default: the mesher's 30 degrees)
+  MeshingOptions frames = [] {  // every later frame is held to these criteria
+    MeshingOptions o;
+    o.min_angle = 20.0;   // degrees
+    return o;
+  }();
+  double first_size_margin = 0.85;  // the first frame refined to `first` with its sizes times this (room to move)
+  // The largest move of a ball in one internal step (Angstrom): the centre's
+  // move plus the change of its radius. A call moving balls farther is
+  // split into equal steps.
+  double max_step = 0.5;
+  // A vertex keeps its id across a step when it moved at most the largest
+  // move of its cell's balls plus this times its longest mesh edge; one
+  // that moved farther (it jumped to another piece of skin) takes a new id.
+  double continuity = 1.0;  // dimensionless
+  RelaxationOptions relaxation;  // for the corners of failing triangles
+  bool edits = true;             // mend failing triangles by edits (split, flip, contraction)
+  double crowded_below = 0.5;    // as MorphOptions::crowded_below
+  double local_repair_share = 0.01;  // as MorphOptions::local_repair_share
+};
+
+class MovingBalls {
+ public:
+  // Meshes the skin of `balls`: the first frame (`t` in its stats).
+  // Throws ContractError for an empty or non-finite ball set or options out
+  // of range, Error when the mesher cannot mesh it.
+  explicit MovingBalls(std::vector<Ball> balls, const MovingOptions& options = {}, double t = 0);
+
+  // Moves every ball to its place in `balls` (the same balls in the same
+  // order: ball i is the same atom), in internal steps of at most
+  // options.max_step, and returns the frame. `t` is recorded in the frame's
+  // stats. Throws ContractError for another number of balls or a
+  // non-finite ball, Error when a step cannot be meshed or certified (the
+  // engine then holds no valid frame and is not to be advanced again).
+  const MorphFrame& advance_to(std::vector<Ball> balls, double t = 0);
+  // The same with every ball's weight kept.
+  const MorphFrame& advance_to(const std::vector<Eigen::Vector3d>& centres, double t = 0);
+
+  const MorphFrame& frame() const { return frame_; }
+  const SkinComplex& complex() const { return complex_; }
+  const std::vector<Ball>& balls() const { return complex_.balls(); }
+  const SkinTopology& topology() const { return topology_; }  // of balls(), which the frame's mesh has
+  // Per vertex of the frame: the ball it belongs to (of its cell's balls,
+  // the one of least power distance).
+  std::vector<int> vertex_balls() const;
+
+ private:
+  void step(std::vector<Ball> balls);
+  void repair(const SkinComplex& next, const SkinTopology& topology, SurfaceMesh& moved, std::vector<char>& lost,
+              const std::vector<char>& stayed);
+  bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
+                     SurfaceMesh& moved, std::vector<char>& lost, long& euler_change);
+  bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
+  MeshingOptions repair_criteria() const { return options_.frames; }
+
+  MovingOptions options_;
+  SkinComplex complex_;
+  SkinTopology topology_;
+  MorphFrame frame_;
+  long next_id_ = 0;
+  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;  // detail::RefusedEdges
+};
+
+// Components, voids and Euler characteristic of a closed triangle mesh
+// (voids: components enclosing negative volume, the triangles outward).
+SkinTopology mesh_topology(const SurfaceMesh& mesh);
+
+}  // namespace skinmesh

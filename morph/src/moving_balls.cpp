@@ -1,0 +1,552 @@
+#include "skinmesh/morph/moving_balls.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/stopwatch.hpp"
+
+#include "local_repair.hpp"
+#include "mesh_part.hpp"
+#include "surgery.hpp"
+#include "vanishing.hpp"
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+namespace skinmesh {
+namespace {
+
+struct TupleHash {
+  size_t operator()(const std::array<int, 4>& k) const {
+    size_t h = 1469598103934665603ull;  // FNV-1a over the four ids
+    for (int v : k) h = (h ^ static_cast<size_t>(v + 1)) * 1099511628211ull;
+    return h;
+  }
+};
+
+double radius_of(const Ball& b) { return std::sqrt(std::max(b.weight, 0.0)); }
+
+// How far a ball moved: its centre's way plus the change of its radius.
+double ball_move(const Ball& a, const Ball& b) {
+  return (b.center - a.center).norm() + std::abs(radius_of(b) - radius_of(a));
+}
+
+// The balls a share `a` of the way from `from` to `to`: centres on the
+// straight line; radii linear where both weights are >= 0 (an atom growing
+// from nothing), weights linear otherwise.
+std::vector<Ball> balls_between(const std::vector<Ball>& from, const std::vector<Ball>& to, double a) {
+  std::vector<Ball> out(from.size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    out[i].center = (1 - a) * from[i].center + a * to[i].center;
+    if (from[i].weight >= 0 && to[i].weight >= 0) {
+      const double r = (1 - a) * radius_of(from[i]) + a * radius_of(to[i]);
+      out[i].weight = r * r;
+    } else {
+      out[i].weight = (1 - a) * from[i].weight + a * to[i].weight;
+    }
+  }
+  return out;
+}
+
+// Per ball, the rotation of least squares (Kabsch 1976, reflection
+// excluded) taking the old centres of the ball and its neighbours in the
+// regular triangulation of `from` onto their new centres: how the
+// neighbourhood turned. Identity for a hidden ball or fewer than three
+// centres. A rigid motion of the whole set gives every ball its rotation.
+std::vector<Eigen::Matrix3d> neighbourhood_rotations(const SkinComplex& from, const std::vector<Ball>& to) {
+  const std::vector<Ball>& old = from.balls();
+  std::vector<Eigen::Matrix3d> rotations(old.size(), Eigen::Matrix3d::Identity());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, old.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<int> near;
+    for (size_t b = r.begin(); b != r.end(); ++b) {
+      const int cell = from.vertex_cell(static_cast<int>(b));
+      if (cell < 0) continue;
+      near.assign(1, static_cast<int>(b));
+      for (auto c = from.cofaces_begin(cell); c != from.cofaces_end(cell); ++c)
+        if (!c->beyond) near.push_back(c->ball);
+      if (near.size() < 3) continue;
+      Eigen::Vector3d p_mean = Eigen::Vector3d::Zero(), q_mean = Eigen::Vector3d::Zero();
+      for (int i : near) {
+        p_mean += old[static_cast<size_t>(i)].center;
+        q_mean += to[static_cast<size_t>(i)].center;
+      }
+      p_mean /= static_cast<double>(near.size());
+      q_mean /= static_cast<double>(near.size());
+      Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+      for (int i : near)
+        h += (old[static_cast<size_t>(i)].center - p_mean) * (to[static_cast<size_t>(i)].center - q_mean).transpose();
+      const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+      d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+      rotations[b] = svd.matrixV() * d * svd.matrixU().transpose();
+    }
+  });
+  return rotations;
+}
+
+// The rotation a cell's patch turns by (docs/math.md section 6): its first
+// ball's neighbourhood rotation, corrected by the least rotation that puts
+// the direction space of delta_X exactly onto its new place (the edge's
+// direction, the triangle's plane), so that the quadric maps onto the new
+// one exactly. A vertex's and a tetrahedron's quadric is isotropic in its
+// direction space: any rotation maps it.
+Eigen::Matrix3d cell_rotation(const MixedCell& cell, const std::vector<Ball>& old, const std::vector<Ball>& now,
+                              const std::vector<Eigen::Matrix3d>& rotations) {
+  const auto at = [](const std::vector<Ball>& balls, int i) { return balls[static_cast<size_t>(i)].center; };
+  const std::array<int, 4>& x = cell.balls;
+  Eigen::Matrix3d r = rotations[static_cast<size_t>(x[0])];
+  Eigen::Vector3d before, after;
+  if (cell.dim == 1) {
+    before = (at(old, x[1]) - at(old, x[0])).normalized();
+    after = (at(now, x[1]) - at(now, x[0])).normalized();
+  } else if (cell.dim == 2) {
+    before = (at(old, x[1]) - at(old, x[0])).cross(at(old, x[2]) - at(old, x[0])).normalized();
+    after = (at(now, x[1]) - at(now, x[0])).cross(at(now, x[2]) - at(now, x[0])).normalized();
+  } else {
+    return r;
+  }
+  const Eigen::Vector3d turned = r * before;
+  if (cell.dim == 2 && turned.dot(after) < 0) after = -after;  // a plane's normal has no sign
+  return Eigen::Quaterniond::FromTwoVectors(turned, after).toRotationMatrix() * r;
+}
+
+enum class VertexFate : char { moved, relocated, lost };
+
+struct MovedVertex {
+  VertexFate fate = VertexFate::moved;
+  bool jumped = false;  // moved farther than continuity allows: a new id
+};
+
+// Per vertex, its longest mesh edge (Angstrom).
+std::vector<double> longest_edges(const SurfaceMesh& mesh) {
+  std::vector<double> longest(mesh.vertices.size(), 0.0);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const size_t a = static_cast<size_t>(t[static_cast<size_t>(k)]);
+      const size_t b = static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)]);
+      const double length = (mesh.vertices[a] - mesh.vertices[b]).norm();
+      longest[a] = std::max(longest[a], length);
+      longest[b] = std::max(longest[b], length);
+    }
+  return longest;
+}
+
+// One vertex from the skin of `from` onto the skin of `to`: by its cell's
+// map where the cell persists with a size of the same sign, else projected
+// from where its owning ball took it.
+MovedVertex move_vertex(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
+                        Eigen::Vector3d& p, int& cell) {
+  const MixedCell& c0 = from.cell(cell);
+  const int persisting = to.find_cell(c0.balls);
+  MovedVertex out;
+  if (persisting >= 0) {
+    const MixedCell& c1 = to.cell(persisting);
+    const double ratio = c1.R2 / c0.R2;
+    if (!c0.degenerate && !c1.degenerate && c0.dim == c1.dim && c0.R2 != 0 && ratio > 0) {
+      const Eigen::Vector3d q =
+          c1.center + std::sqrt(ratio) * (cell_rotation(c0, from.balls(), to.balls(), rotations) * (p - c0.center));
+      constexpr double kOnBoundary = 1e-9;  // Angstrom-scaled membership slack (rounding on a cell face)
+      if (to.membership_violation(persisting, q) <= kOnBoundary) {
+        p = q;
+        cell = persisting;
+        return out;
+      }
+      const Projection projected = to.project(q, persisting, 1e-14);
+      out.fate = projected.converged ? VertexFate::relocated : VertexFate::lost;
+      if (projected.converged) {
+        p = projected.point;
+        cell = projected.cell;
+      }
+      return out;
+    }
+  }
+  const int owner = from.owning_ball(p, cell);
+  const Eigen::Vector3d start =
+      p + (to.balls()[static_cast<size_t>(owner)].center - from.balls()[static_cast<size_t>(owner)].center);
+  const int hint = persisting >= 0 ? persisting : to.vertex_cell(owner);
+  const Projection projected = to.project(start, hint, 1e-14);
+  out.fate = projected.converged ? VertexFate::relocated : VertexFate::lost;
+  if (projected.converged) {
+    p = projected.point;
+    cell = projected.cell;
+  } else {
+    cell = to.locate(p, hint);  // a valid cell of the new complex for a vertex the remesh drops
+  }
+  return out;
+}
+
+// A critical cell: its centre z_X lies in its own mixed cell, where the
+// skin changes topology when R2_X changes sign (Edelsbrunner 1999; docs/math.md
+// section 6). Keyed by ball tuple, with the sign of its size.
+std::unordered_map<std::array<int, 4>, bool, TupleHash> critical_cells(const SkinComplex& complex) {
+  std::vector<char> critical(complex.cells().size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, critical.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t c = r.begin(); c != r.end(); ++c) {
+      const MixedCell& cell = complex.cells()[c];
+      critical[c] = !cell.degenerate && cell.R2 != 0 &&
+                    complex.membership_violation(static_cast<int>(c), cell.center) <= 0;
+    }
+  });
+  std::unordered_map<std::array<int, 4>, bool, TupleHash> out;
+  for (size_t c = 0; c < critical.size(); ++c)
+    if (critical[c]) out.emplace(complex.cells()[c].balls, complex.cells()[c].R2 < 0);
+  return out;
+}
+
+// Where the skin's topology may have changed in the step, as places the
+// local repair must remesh (local_repair.hpp), with the change of the Euler
+// characteristic. An event is a critical cell whose size changed sign; a
+// critical cell that appeared or went (a flip, or a cancelling pair of
+// critical points) is taken as a place too, without a birth. A void or
+// component born (a tetrahedron's size turned positive, a vertex's
+// negative) is seeded there. False when one vanished (a void filled, a
+// component gone) is listed in `vanished`, at its place in the step
+// before: its component is dropped before the repair (vanishing.hpp).
+void topology_changes(const SkinComplex& from, const SkinComplex& to, detail::LocalRepairOptions& local,
+                      std::vector<detail::VanishingSphere>& vanished) {
+  const auto before = critical_cells(from), after = critical_cells(to);
+  const auto place = [&](const MixedCell& cell, int index, bool birth) {
+    detail::TopologyChange change;
+    change.point = cell.center;
+    change.size = std::sqrt(std::abs(cell.R2));
+    change.radius = 1.0 + 2 * change.size;
+    change.birth = birth;
+    change.cell = index;
+    local.changes.push_back(change);
+  };
+  for (const auto& [balls, inside] : after) {
+    const auto was = before.find(balls);
+    if (was != before.end() && was->second == inside) continue;
+    const int c = to.find_cell(balls);
+    const MixedCell& cell = to.cell(c);
+    const bool event = was != before.end();
+    if (event && ((cell.dim == 0 && !inside) || (cell.dim == 3 && inside))) {  // a sphere vanished
+      const MixedCell& old = from.cell(from.find_cell(balls));
+      vanished.push_back({old.center, 1.0 + 2 * std::sqrt(std::abs(old.R2))});
+      continue;
+    }
+    place(cell, c, event && (cell.dim == 0 || cell.dim == 3));
+  }
+  for (const auto& [balls, inside] : before)
+    if (!after.count(balls)) place(from.cell(from.find_cell(balls)), -1, false);
+}
+
+MeshingOptions with_size_margin(MeshingOptions o, double margin) {
+  o.sizing.epsilon *= margin;
+  o.edge_length *= margin;
+  o.tolerance *= margin;
+  return o;
+}
+
+void check_balls(const std::vector<Ball>& balls, const char* what) {
+  for (const Ball& b : balls)
+    if (!b.center.allFinite() || !std::isfinite(b.weight)) contract_error(std::string(what) + ": a ball is not finite");
+}
+
+}  // namespace
+
+SkinTopology mesh_topology(const SurfaceMesh& mesh) {
+  const size_t n = mesh.vertices.size();
+  std::vector<size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), size_t{0});
+  const auto find = [&](size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(mesh.triangles.size() * 3);
+  std::vector<char> used(n, 0);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
+      used[static_cast<size_t>(a)] = 1;
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+      parent[find(static_cast<size_t>(a))] = find(static_cast<size_t>(b));
+    }
+  std::sort(edges.begin(), edges.end());
+  const long edge_count = std::unique(edges.begin(), edges.end()) - edges.begin();
+  std::unordered_map<size_t, double> volume;  // signed, per component root
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
+    volume[find(static_cast<size_t>(t[0]))] +=
+        a.dot(mesh.vertices[static_cast<size_t>(t[1])].cross(mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
+  }
+  SkinTopology out;
+  out.components = static_cast<long>(volume.size());
+  for (const auto& [root, v] : volume) out.voids += v < 0;
+  const long vertices = std::count(used.begin(), used.end(), 1);
+  out.euler = vertices - edge_count + static_cast<long>(mesh.triangles.size());
+  return out;
+}
+
+MovingBalls::MovingBalls(std::vector<Ball> balls, const MovingOptions& options, double t) : options_(options) {
+  if (balls.empty()) contract_error("MovingBalls: the ball set is empty");
+  check_balls(balls, "MovingBalls");
+  if (!(options.max_step > 0) || !(options.continuity >= 0))
+    contract_error("MovingBalls: max_step must be positive and continuity non-negative");
+  const auto start = Clock::now();
+  complex_ = build_skin_complex(std::move(balls), {options.shrink});
+  topology_ = skin_topology(complex_.balls());
+  frame_.stats.seconds_complex = seconds_since(start);
+  const auto mesh_start = Clock::now();
+  SkinMeshResult made = mesh_skin(complex_, with_size_margin(options.first, options.first_size_margin));
+  if (made.status != MeshingStatus::ok) throw Error("moving balls, first frame: " + made.message);
+  frame_.mesh = std::move(made.mesh);
+  frame_.ids.resize(frame_.mesh.vertices.size());
+  std::iota(frame_.ids.begin(), frame_.ids.end(), 0L);
+  next_id_ = static_cast<long>(frame_.ids.size());
+  FrameStats& s = frame_.stats;
+  s.t = t;
+  s.full_rebuild = true;
+  s.inserted = static_cast<long>(frame_.mesh.vertices.size());
+  s.vertices = s.inserted;
+  s.triangles = static_cast<long>(frame_.mesh.triangles.size());
+  s.seconds_repair = seconds_since(mesh_start);
+  s.topology_certified = mesh_topology(frame_.mesh) == topology_;
+  if (!s.topology_certified)
+    throw Error("moving balls, first frame: the mesh has " + mesh_topology(frame_.mesh).text() + ", the skin " +
+                topology_.text());
+  s.seconds = seconds_since(start);
+}
+
+const MorphFrame& MovingBalls::advance_to(const std::vector<Eigen::Vector3d>& centres, double t) {
+  std::vector<Ball> balls = complex_.balls();
+  if (centres.size() != balls.size()) contract_error("MovingBalls::advance_to: the number of centres differs");
+  for (size_t i = 0; i < balls.size(); ++i) balls[i].center = centres[i];
+  return advance_to(std::move(balls), t);
+}
+
+const MorphFrame& MovingBalls::advance_to(std::vector<Ball> balls, double t) {
+  const std::vector<Ball> from = complex_.balls();
+  if (balls.size() != from.size()) contract_error("MovingBalls::advance_to: the number of balls differs");
+  check_balls(balls, "MovingBalls::advance_to");
+  const auto start = Clock::now();
+  std::unordered_map<long, Eigen::Vector3d> before;  // the frame before, by vertex id
+  before.reserve(frame_.ids.size());
+  for (size_t v = 0; v < frame_.ids.size(); ++v) before.emplace(frame_.ids[v], frame_.mesh.vertices[v]);
+  double farthest = 0;
+  for (size_t i = 0; i < from.size(); ++i) farthest = std::max(farthest, ball_move(from[i], balls[i]));
+  const long steps = std::max(1L, static_cast<long>(std::ceil(farthest / options_.max_step)));
+  frame_.stats = FrameStats{};
+  frame_.stats.t = t;
+  for (long k = 1; k <= steps; ++k)
+    step(k == steps ? std::move(balls) : balls_between(from, balls, static_cast<double>(k) / static_cast<double>(steps)));
+  FrameStats& s = frame_.stats;
+  s.steps = steps;
+  long kept = 0;
+  for (size_t v = 0; v < frame_.ids.size(); ++v) {
+    const auto found = before.find(frame_.ids[v]);
+    if (found == before.end()) continue;
+    ++kept;
+    s.max_kept_move = std::max(s.max_kept_move, (frame_.mesh.vertices[v] - found->second).norm());
+  }
+  s.vertices = static_cast<long>(frame_.mesh.vertices.size());
+  s.triangles = static_cast<long>(frame_.mesh.triangles.size());
+  s.ids_kept = s.vertices > 0 ? static_cast<double>(kept) / static_cast<double>(s.vertices) : 0.0;
+  s.inserted = s.vertices - kept;
+  s.removed = static_cast<long>(before.size()) - kept;
+  s.seconds = seconds_since(start);
+  return frame_;
+}
+
+std::vector<int> MovingBalls::vertex_balls() const {
+  std::vector<int> owner(frame_.mesh.vertices.size());
+  for (size_t v = 0; v < owner.size(); ++v) owner[v] = complex_.owning_ball(frame_.mesh.vertices[v], frame_.mesh.cells[v]);
+  return owner;
+}
+
+// One internal step: the new complex, every vertex moved onto its skin,
+// judged, mended and certified (moving_balls.hpp).
+void MovingBalls::step(std::vector<Ball> balls) {
+  FrameStats& s = frame_.stats;
+  auto stage = Clock::now();
+  SkinComplex next = build_skin_complex(std::move(balls), {options_.shrink});
+  const SkinTopology topology = skin_topology(next.balls());
+  const std::vector<Eigen::Matrix3d> rotations = neighbourhood_rotations(complex_, next.balls());
+  s.seconds_complex += seconds_since(stage);
+  stage = Clock::now();
+  SurfaceMesh moved = frame_.mesh;
+  const std::vector<double> longest = longest_edges(moved);
+  const size_t n = moved.vertices.size();
+  std::vector<MovedVertex> fates(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const Eigen::Vector3d was = moved.vertices[v];
+      const MixedCell& c0 = complex_.cell(moved.cells[v]);
+      double allowed = 0;  // the largest move of the cell's balls
+      for (int i = 0; i <= c0.dim; ++i) {
+        const size_t b = static_cast<size_t>(c0.balls[static_cast<size_t>(i)]);
+        allowed = std::max(allowed, ball_move(complex_.balls()[b], next.balls()[b]));
+      }
+      fates[v] = move_vertex(complex_, next, rotations, moved.vertices[v], moved.cells[v]);
+      fates[v].jumped = (moved.vertices[v] - was).norm() > allowed + options_.continuity * longest[v];
+      if (fates[v].fate != VertexFate::lost)
+        moved.normals[v] = next.evaluate(moved.vertices[v], moved.cells[v]).gradient.normalized();
+    }
+  });
+  std::vector<char> lost(n, 0), stayed(n, 0);
+  for (size_t v = 0; v < n; ++v) {
+    lost[v] = fates[v].fate == VertexFate::lost;
+    stayed[v] = fates[v].fate == VertexFate::moved;
+    s.moved += fates[v].fate == VertexFate::moved;
+    s.relocated += fates[v].fate == VertexFate::relocated;
+    s.lost += lost[v];
+    if (fates[v].jumped && !lost[v]) {
+      frame_.ids[v] = next_id_++;
+      ++s.reidentified;
+    }
+  }
+  s.seconds_transport += seconds_since(stage);
+  repair(next, topology, moved, lost, stayed);
+  complex_ = std::move(next);
+  topology_ = topology;
+}
+
+// The moved step made the frame: kept as it is, or mended, cheapest first
+// (moving_balls.hpp); throws Error when no mesh of the step can be certified.
+void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, SurfaceMesh& moved,
+                         std::vector<char>& lost, const std::vector<char>& stayed) {
+  FrameStats& s = frame_.stats;
+  const auto follow = [&](const std::vector<long>& origin) {  // the frame's ids onto an edited mesh's vertices
+    std::vector<long> ids(origin.size());
+    for (size_t v = 0; v < ids.size(); ++v) ids[v] = origin[v] >= 0 ? frame_.ids[static_cast<size_t>(origin[v])] : next_id_++;
+    frame_.ids = std::move(ids);
+  };
+  long left = 0;
+  // Where the topology changed; a component or void that vanished is
+  // dropped first (its sphere of triangles has no skin left to go to), and
+  // one that cannot be found as a component of its own sends the step to
+  // the whole remesh at once (edits would be wasted on it).
+  detail::LocalRepairOptions local;
+  local.crowded_below = options_.crowded_below;
+  std::vector<detail::VanishingSphere> vanished;
+  topology_changes(complex_, next, local, vanished);
+  local.euler_change = topology.euler - topology_.euler;
+  const bool local_topology = vanished.empty() || drop_vanished(vanished, stayed, moved, lost, local.euler_change);
+  const bool any_lost = std::find(lost.begin(), lost.end(), 1) != lost.end();
+  if (!any_lost && local_topology) {
+    auto stage = Clock::now();
+    std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+    left = std::count(failing.begin(), failing.end(), 1);
+    s.bad_triangles += left;
+    s.seconds_judge += seconds_since(stage);
+    if (left > 0 && options_.relaxation.passes > 0) {
+      stage = Clock::now();
+      std::vector<char> corners(moved.vertices.size(), 0);
+      for (size_t f = 0; f < failing.size(); ++f)
+        if (failing[f])
+          for (int v : moved.triangles[f]) corners[static_cast<size_t>(v)] = 1;
+      relax_tangentially(next, moved, options_.relaxation, &corners);
+      s.seconds_relax += seconds_since(stage);
+      stage = Clock::now();
+      failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+      left = std::count(failing.begin(), failing.end(), 1);
+      s.seconds_judge += seconds_since(stage);
+    }
+    stage = Clock::now();
+    if (left > 0 && options_.edits) {
+      detail::Surgery edited = detail::mend_by_edits(next, std::move(moved), failing, options_.frames, {}, &frame_.ids,
+                                                     &refused_thinning_);
+      follow(edited.origin);
+      moved = std::move(edited.mesh);
+      failing = std::move(edited.failing);
+      left = edited.left;
+      s.split += edited.splits;
+      s.flipped += edited.flips;
+      s.contracted += edited.contractions;
+      s.repaired = true;
+    }
+    if ((left > 0 || !local.changes.empty()) &&
+        left <= options_.local_repair_share * static_cast<double>(failing.size())) {
+      detail::LocalRepair patched = detail::repair_locally(next, moved, failing, repair_criteria(), options_.frames, local);
+      if (patched.ok) {
+        follow(patched.origin);
+        moved = std::move(patched.mesh);
+        left = 0;
+        s.repaired = true;
+        s.patch_triangles += patched.patch_triangles;
+        s.repairs += patched.repairs;
+      }
+    }
+    s.seconds_repair += seconds_since(stage);
+    if (left == 0 && mesh_topology(moved) == topology) {
+      frame_.mesh = std::move(moved);
+      s.topology_certified = true;
+      return;
+    }
+  }
+  const auto stage = Clock::now();
+  if (!any_lost) lost.assign(moved.vertices.size(), 0);  // the edits may have renumbered the vertices
+  s.crowded += detail::mark_crowded(next, moved, options_.frames, options_.crowded_below, lost);
+  const bool remeshed = remesh(next, moved, lost, repair_criteria());
+  if (!remeshed || mesh_topology(frame_.mesh) != topology) {
+    SkinMeshResult made = mesh_skin(next, repair_criteria());
+    if (made.status != MeshingStatus::ok) throw Error("moving balls: a step the mesher cannot mesh: " + made.message);
+    frame_.mesh = std::move(made.mesh);
+    frame_.ids.resize(frame_.mesh.vertices.size());
+    for (long& id : frame_.ids) id = next_id_++;
+    s.full_rebuild = true;
+  }
+  s.repaired = true;
+  s.remeshed = true;
+  s.seconds_repair += seconds_since(stage);
+  const SkinTopology made = mesh_topology(frame_.mesh);
+  if (made != topology)
+    throw Error("moving balls: a step's mesh has " + made.text() + " where the skin has " + topology.text() +
+                "; the frame is refused");
+  s.topology_certified = true;
+}
+
+// The components of the step before that `vanished` took (vanishing.hpp),
+// dropped from `moved` with their ids and their entries in `lost`;
+// `euler_change` gains 2 for each, since the repair counts from the mesh
+// without them. False when one is not found as a component of its own.
+bool MovingBalls::drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
+                                SurfaceMesh& moved, std::vector<char>& lost, long& euler_change) {
+  std::vector<char> found;
+  const std::vector<char> gone =
+      detail::vanishing_components(frame_.mesh, std::vector<char>(stayed.size(), 0), vanished, found);
+  if (std::find(found.begin(), found.end(), 0) != found.end()) return false;
+  std::vector<char> keep(moved.triangles.size());
+  for (size_t f = 0; f < keep.size(); ++f) keep[f] = !gone[static_cast<size_t>(moved.triangles[f][0])];
+  std::vector<int> kept_from;
+  moved = detail::used_part(moved, keep, kept_from);
+  std::vector<long> ids;
+  std::vector<char> kept_lost;
+  for (int v : kept_from) {
+    ids.push_back(frame_.ids[static_cast<size_t>(v)]);
+    kept_lost.push_back(lost[static_cast<size_t>(v)]);
+  }
+  frame_.ids = std::move(ids);
+  lost = std::move(kept_lost);
+  euler_change += 2 * static_cast<long>(vanished.size());
+  return true;
+}
+
+// The whole step remeshed from the moved vertices not dropped (remesh_skin);
+// false when the mesher cannot.
+bool MovingBalls::remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop,
+                         const MeshingOptions& criteria) {
+  std::vector<SkinSample> samples;
+  std::vector<long> sample_ids;
+  for (size_t v = 0; v < moved.vertices.size(); ++v) {
+    if (drop[v]) continue;
+    samples.push_back({moved.vertices[v], moved.cells[v]});
+    sample_ids.push_back(frame_.ids[v]);
+  }
+  SkinMeshResult made = remesh_skin(next, samples, criteria);
+  if (made.status != MeshingStatus::ok) return false;
+  std::vector<long> ids(made.mesh.vertices.size());
+  for (size_t v = 0; v < ids.size(); ++v)
+    ids[v] = made.origins[v] >= 0 ? sample_ids[static_cast<size_t>(made.origins[v])] : next_id_++;
+  frame_.mesh = std::move(made.mesh);
+  frame_.ids = std::move(ids);
+  return true;
+}
+
+}  // namespace skinmesh

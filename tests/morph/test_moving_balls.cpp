@@ -1,0 +1,273 @@
+// Moving balls (docs/math.md section 6): the topology count from the weighted
+// alpha complex against the mesher and shapes whose topology is known; the
+// engine on rigid motions, identity, a hinge motion checked by the static
+// oracle, atoms that grow and shrink, a three-model trajectory; the
+// certificate refusing a wrong mesh.
+#include "test_support.hpp"
+
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/skin_topology.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/alignment.hpp"
+#include "skinmesh/morph/matched_motion.hpp"
+#include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+using namespace skinmesh;
+
+namespace {
+
+std::vector<Ball> molecule_balls(const std::string& name, int model = 1) {
+  ReadOptions read;
+  read.model = model;
+  return balls_from_molecule(read_molecule(test::data_file(name), read), 0.5);
+}
+
+SkinTopology meshed_topology(const std::vector<Ball>& balls) {
+  const SkinMeshResult made = mesh_skin(build_skin_complex(balls));
+  REQUIRE(made.status == MeshingStatus::ok);
+  return mesh_topology(made.mesh);
+}
+
+// Every check a frame of moving balls must pass, against references that
+// do not use the engine: the static oracle on the frame's balls (1e-8 A),
+// the angle bound, a closed oriented manifold without self-intersections,
+// and the topology of the mesher's mesh of those balls from scratch.
+void check_frame(const MovingBalls& moving, const std::vector<Ball>& balls, double min_angle) {
+  const MorphFrame& f = moving.frame();
+  const SkinOracle oracle(balls, 0.5);
+  double worst = 0;
+  for (const Eigen::Vector3d& x : f.mesh.vertices) worst = std::max(worst, oracle.evaluate(x).distance());
+  CHECK(worst < 1e-8);
+  const MeshQuality q = grade_mesh(f.mesh);
+  CHECK(q.min_angle >= min_angle - 1e-9);
+  CHECK(q.closed);
+  CHECK(q.manifold);
+  CHECK(q.oriented);
+  CHECK(q.self_intersecting_pairs == 0);
+  const SkinTopology scratch = meshed_topology(balls);
+  CHECK(q.components == scratch.components);
+  CHECK(q.euler == scratch.euler);
+  CHECK(f.stats.topology_certified);
+}
+
+// A copy of `balls` with those of `moving` turned by `degrees` about `axis` through `pivot`.
+std::vector<Ball> hinged(std::vector<Ball> balls, const std::vector<char>& moving, const Eigen::Vector3d& pivot,
+                         const Eigen::Vector3d& axis, double degrees) {
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(degrees * M_PI / 180, axis.normalized()).toRotationMatrix();
+  for (size_t i = 0; i < balls.size(); ++i)
+    if (moving[i]) balls[i].center = pivot + turn * (balls[i].center - pivot);
+  return balls;
+}
+
+}  // namespace
+
+TEST_CASE("skin topology from the alpha complex: shapes of known topology", "[moving][topology]") {
+  SECTION("one ball, two apart, two overlapping") {
+    CHECK(skin_topology({{Eigen::Vector3d::Zero(), 4.0}}) == SkinTopology{1, 0, 2});
+    CHECK(skin_topology({{Eigen::Vector3d::Zero(), 4.0}, {Eigen::Vector3d(10, 0, 0), 4.0}}) == SkinTopology{2, 0, 4});
+    CHECK(skin_topology({{Eigen::Vector3d::Zero(), 4.0}, {Eigen::Vector3d(3, 0, 0), 4.0}}) == SkinTopology{1, 0, 2});
+    CHECK(skin_topology({{Eigen::Vector3d::Zero(), -1.0}}) == SkinTopology{0, 0, 0});
+  }
+  SECTION("a ring of balls is a torus") {
+    std::vector<Ball> ring;
+    for (int k = 0; k < 12; ++k) ring.push_back({Eigen::Vector3d(6 * std::cos(k * M_PI / 6), 6 * std::sin(k * M_PI / 6), 0), 4.0});
+    CHECK(skin_topology(ring) == SkinTopology{1, 0, 0});
+    CHECK(meshed_topology(ring) == SkinTopology{1, 0, 0});
+  }
+  SECTION("a closed shell of balls holds a void") {
+    std::vector<Ball> shell;  // balls on a Fibonacci sphere of radius 8 A
+    const int n = 120;
+    for (int i = 0; i < n; ++i) {
+      const double z = 1 - (2 * i + 1.0) / n, phi = i * M_PI * (3 - std::sqrt(5.0));
+      const double r = std::sqrt(1 - z * z);
+      shell.push_back({8.0 * Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z), 9.0});
+    }
+    const SkinTopology counted = skin_topology(shell);
+    CHECK(counted.voids == 1);
+    CHECK(counted.components == 2);
+    CHECK(counted == meshed_topology(shell));
+  }
+}
+
+TEST_CASE("skin topology from the alpha complex equals the mesher's on every molecule of data/", "[moving][topology]") {
+  for (const char* name : {"pept.pdb", "1ubi.pdb", "3al1.pdb", "2k39_3models.pdb", "1ejg.pdb"}) {
+    INFO(name);
+    const std::vector<Ball> balls = molecule_balls(name);
+    CHECK(skin_topology(balls) == meshed_topology(balls));
+  }
+}
+
+TEST_CASE("moving balls: a rigid translation moves every vertex rigidly, ids kept, no repair", "[moving]") {
+  const std::vector<Ball> start = molecule_balls("pept.pdb");
+  MovingBalls moving(start);
+  const SurfaceMesh first = moving.frame().mesh;
+  const std::vector<long> first_ids = moving.frame().ids;
+  const Eigen::Vector3d shift(20, 0, 0);
+  for (int k = 1; k <= 10; ++k) {
+    const double t = k / 10.0;
+    std::vector<Ball> balls = start;
+    for (Ball& b : balls) b.center += t * shift;
+    const MorphFrame& f = moving.advance_to(balls, t);
+    INFO("t = " << t);
+    REQUIRE(f.ids == first_ids);
+    REQUIRE(f.mesh.triangles == first.triangles);
+    double worst = 0;
+    for (size_t v = 0; v < first.vertices.size(); ++v)
+      worst = std::max(worst, (f.mesh.vertices[v] - (first.vertices[v] + t * shift)).norm());
+    CHECK(worst < 1e-9);
+    CHECK_FALSE(f.stats.repaired);
+    CHECK(f.stats.reidentified == 0);
+    CHECK(f.stats.ids_kept == 1.0);
+    CHECK(f.stats.topology_certified);
+  }
+}
+
+TEST_CASE("moving balls: a rigid rotation turns every vertex with the molecule", "[moving]") {
+  const std::vector<Ball> start = molecule_balls("pept.pdb");
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Ball& b : start) centre += b.center / static_cast<double>(start.size());
+  MovingOptions one_step;  // the frames' motion is a rotation; steps between them would take straight lines
+  one_step.max_step = 100;
+  MovingBalls moving(start, one_step);
+  const SurfaceMesh first = moving.frame().mesh;
+  const std::vector<char> all(start.size(), 1);
+  for (int k = 1; k <= 4; ++k) {
+    const double degrees = 5.0 * k;
+    const MorphFrame& f = moving.advance_to(hinged(start, all, centre, Eigen::Vector3d(1, 2, 3), degrees), k);
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(degrees * M_PI / 180, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    REQUIRE(f.mesh.vertices.size() == first.vertices.size());
+    double worst = 0;
+    for (size_t v = 0; v < first.vertices.size(); ++v)
+      worst = std::max(worst, (f.mesh.vertices[v] - (centre + turn * (first.vertices[v] - centre))).norm());
+    CHECK(worst < 1e-8);
+    CHECK(f.stats.ids_kept == 1.0);
+  }
+}
+
+TEST_CASE("moving balls: the same balls again give the same frame", "[moving]") {
+  const std::vector<Ball> start = molecule_balls("pept.pdb");
+  MovingBalls moving(start);
+  const MorphFrame first = moving.frame();
+  for (int k = 1; k <= 3; ++k) {
+    const MorphFrame& f = moving.advance_to(start, k);
+    REQUIRE(f.ids == first.ids);
+    REQUIRE(f.mesh.triangles == first.mesh.triangles);
+    double worst = 0;
+    for (size_t v = 0; v < f.mesh.vertices.size(); ++v)
+      worst = std::max(worst, (f.mesh.vertices[v] - first.mesh.vertices[v]).norm());
+    CHECK(worst < 1e-12);
+    CHECK_FALSE(f.stats.repaired);
+  }
+}
+
+TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every frame checked", "[moving]") {
+  ReadOptions read;
+  const Molecule ubi = read_molecule(test::data_file("1ubi.pdb"), read);
+  const std::vector<Ball> start = balls_from_molecule(ubi, 0.5);
+  std::vector<char> strand(start.size(), 0);
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < ubi.atoms.size(); ++i) {
+    strand[i] = ubi.atoms[i].residue_number >= 66;
+    if (ubi.atoms[i].residue_number == 65 && ubi.atoms[i].name == "CA") pivot = ubi.atoms[i].position;
+  }
+  const Eigen::Vector3d axis(0, 0, 1);
+  MovingBalls moving(start);
+  const int frames = 20;
+  const double degrees = 40;
+  std::vector<Ball> before = start;
+  for (int k = 1; k <= frames; ++k) {
+    const std::vector<Ball> balls = hinged(start, strand, pivot, axis, degrees * k / frames);
+    double atom_move = 0;
+    for (size_t i = 0; i < balls.size(); ++i) atom_move = std::max(atom_move, (balls[i].center - before[i].center).norm());
+    REQUIRE(atom_move <= 1.0);
+    const MorphFrame& f = moving.advance_to(balls, static_cast<double>(k) / frames);
+    INFO("frame " << k << ": " << f.stats.vertices << " vertices, ids kept " << f.stats.ids_kept << ", remeshed "
+                   << f.stats.remeshed);
+    // A frame remeshed whole (a void vanished that is not a component of its
+    // own in the frame before) gives new ids to what refinement inserts.
+    CHECK(f.stats.ids_kept >= (f.stats.remeshed ? 0.8 : 0.9));
+    if (k % 4 == 0) check_frame(moving, balls, 20.0);  // five values of t
+    before = balls;
+  }
+}
+
+TEST_CASE("moving balls: atoms on one side only grow out of and shrink into their anchor", "[moving]") {
+  ReadOptions read;
+  const Molecule full = read_molecule(test::data_file("pept.pdb"), read);
+  Molecule fewer = full;
+  // A side chain's end present in the target only, the first atom in the source only.
+  const size_t dropped = fewer.atoms.size() - 1;
+  fewer.atoms.erase(fewer.atoms.begin() + static_cast<long>(dropped));
+  Molecule target = full;
+  target.atoms.erase(target.atoms.begin());
+  const std::vector<Ball> source_balls = balls_from_molecule(fewer, 0.5), target_balls = balls_from_molecule(target, 0.5);
+  const MatchedMotion motion = match_motion(fewer, source_balls, target, target_balls);
+  CHECK(motion.source_only == 1);
+  CHECK(motion.target_only == 1);
+  CHECK(motion.matched == static_cast<long>(full.atoms.size()) - 2);
+  // The ends are the sides' own skins.
+  const std::vector<Ball> at0 = motion.balls_at(0), at1 = motion.balls_at(1);
+  const SkinOracle source_oracle(source_balls, 0.5), target_oracle(target_balls, 0.5);
+  MovingBalls moving(at0);
+  for (const Eigen::Vector3d& x : moving.frame().mesh.vertices) REQUIRE(source_oracle.evaluate(x).distance() < 1e-8);
+  for (int k = 1; k <= 4; ++k) {
+    const double t = k / 4.0;
+    const std::vector<Ball> balls = motion.balls_at(t);
+    moving.advance_to(balls, t);
+    check_frame(moving, balls, 20.0);
+  }
+  double worst = 0;
+  for (const Eigen::Vector3d& x : moving.frame().mesh.vertices) worst = std::max(worst, target_oracle.evaluate(x).distance());
+  CHECK(worst < 1e-8);
+}
+
+TEST_CASE("moving balls: ubiquitin's NMR models 1 -> 2 -> 3 as one motion, ids kept across models", "[moving]") {
+  // data/2k39_3models.pdb (residues 1-10 of three models), each model
+  // fitted onto the first, five frames from one model to the next.
+  ReadOptions read;
+  const Molecule first = read_molecule(test::data_file("2k39_3models.pdb"), read);
+  MovingBalls moving(balls_from_molecule(first, 0.5));
+  std::vector<Ball> before = moving.balls();
+  for (int model = 2; model <= 3; ++model) {
+    read.model = model;
+    Molecule m = read_molecule(test::data_file("2k39_3models.pdb"), read);
+    m = moved(std::move(m), align(first, m, AlignmentMethod::kabsch).motion);
+    const std::vector<Ball> keyframe = balls_from_molecule(m, 0.5);
+    REQUIRE(keyframe.size() == before.size());
+    for (int k = 1; k <= 5; ++k) {
+      std::vector<Ball> balls = keyframe;
+      for (size_t i = 0; i < balls.size(); ++i) balls[i].center = before[i].center + k / 5.0 * (keyframe[i].center - before[i].center);
+      if (k == 5) balls = keyframe;
+      const MorphFrame& f = moving.advance_to(balls, model - 1 + k / 5.0);
+      INFO("model " << model << " frame " << k << ": ids kept " << f.stats.ids_kept << ", remeshed " << f.stats.remeshed);
+      CHECK(f.stats.ids_kept >= 0.5);
+      CHECK(f.stats.topology_certified);
+    }
+    check_frame(moving, keyframe, 20.0);  // the keyframe reached exactly: the model's own skin
+    before = keyframe;
+  }
+}
+
+TEST_CASE("the topology certificate refuses a mesh whose bookkeeping is wrong", "[moving]") {
+  const std::vector<Ball> balls = molecule_balls("1ubi.pdb");
+  const MovingBalls moving(balls);
+  const SurfaceMesh& mesh = moving.frame().mesh;
+  REQUIRE(mesh_topology(mesh) == skin_topology(balls));
+  // One component (a void's surface) left out: the count no longer holds.
+  const SurfaceComponents parts = surface_components(mesh);
+  SurfaceMesh wrong = mesh;
+  wrong.triangles.clear();
+  for (size_t f = 0; f < mesh.triangles.size(); ++f)
+    if (parts.of_triangle[f] != parts.of_triangle.back()) wrong.triangles.push_back(mesh.triangles[f]);
+  CHECK_FALSE(mesh_topology(wrong) == skin_topology(balls));
+}
