@@ -180,36 +180,77 @@ MovedVertex move_vertex(const SkinComplex& from, const SkinComplex& to, const st
   return out;
 }
 
-// A critical cell: its centre z_X lies in its own mixed cell, where the
-// skin changes topology when R2_X changes sign (Edelsbrunner 1999; docs/math.md
-// section 6). Keyed by ball tuple, with the sign of its size.
-std::unordered_map<std::array<int, 4>, bool, TupleHash> critical_cells(const SkinComplex& complex) {
+// The critical cells inside the body: z_X lies in its own mixed cell and
+// R2_X < 0. By discrete Morse theory on the alpha filtration they alone
+// make the body's homotopy type, each adding (-1)^dim to its Euler
+// characteristic (Edelsbrunner 1999; docs/math.md section 6). Keyed by
+// ball tuple.
+std::unordered_map<std::array<int, 4>, int, TupleHash> inside_critical_cells(const SkinComplex& complex) {
   std::vector<char> critical(complex.cells().size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, critical.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t c = r.begin(); c != r.end(); ++c) {
       const MixedCell& cell = complex.cells()[c];
-      critical[c] = !cell.degenerate && cell.R2 != 0 &&
+      critical[c] = !cell.degenerate && cell.R2 < 0 &&
                     complex.membership_violation(static_cast<int>(c), cell.center) <= 0;
     }
   });
-  std::unordered_map<std::array<int, 4>, bool, TupleHash> out;
+  std::unordered_map<std::array<int, 4>, int, TupleHash> out;
   for (size_t c = 0; c < critical.size(); ++c)
-    if (critical[c]) out.emplace(complex.cells()[c].balls, complex.cells()[c].R2 < 0);
+    if (critical[c]) out.emplace(complex.cells()[c].balls, static_cast<int>(c));
   return out;
 }
 
-// Where the skin's topology may have changed in the step, as places the
-// local repair must remesh (local_repair.hpp), with the change of the Euler
-// characteristic. An event is a critical cell whose size changed sign; a
-// critical cell that appeared or went (a flip, or a cancelling pair of
-// critical points) is taken as a place too, without a birth. A void or
-// component born (a tetrahedron's size turned positive, a vertex's
-// negative) is seeded there. False when one vanished (a void filled, a
-// component gone) is listed in `vanished`, at its place in the step
-// before: its component is dropped before the repair (vanishing.hpp).
-void topology_changes(const SkinComplex& from, const SkinComplex& to, detail::LocalRepairOptions& local,
-                      std::vector<detail::VanishingSphere>& vanished) {
-  const auto before = critical_cells(from), after = critical_cells(to);
+// Where the skin's topology changed in the step, as places the local
+// repair must remesh (local_repair.hpp): the inside critical cells of one
+// side that the other lacks, less the pairs a flip only renamed (same
+// dimension, centres within 0.05 A). A vertex cell that became one is a
+// component born, a tetrahedron that stopped being one a void born: both
+// seeded. A tetrahedron that became one (a void filled) or a vertex cell
+// that stopped (a component gone) is listed in `vanished`, at its place
+// in the step before: its component is dropped before the repair
+// (vanishing.hpp). When the counts did not change (`same_topology`), the
+// places are pairs of critical points that cancel: no birth, nothing vanished.
+void topology_changes(const SkinComplex& from, const SkinComplex& to, bool same_topology,
+                      detail::LocalRepairOptions& local, std::vector<detail::VanishingSphere>& vanished) {
+  const auto before = inside_critical_cells(from), after = inside_critical_cells(to);
+  std::vector<const MixedCell*> gone, came;
+  std::vector<int> came_index;
+  for (const auto& [balls, c] : before)
+    if (!after.count(balls)) gone.push_back(&from.cell(c));
+  for (const auto& [balls, c] : after)
+    if (!before.count(balls)) {
+      came.push_back(&to.cell(c));
+      came_index.push_back(c);
+    }
+  // A k-cell and a (k+1)-cell having it as a face that appear (or go)
+  // together are a cancelling pair of critical points: no change.
+  const auto is_face = [](const MixedCell& f, const MixedCell& c) {
+    if (c.dim != f.dim + 1) return false;
+    for (int i = 0; i <= f.dim; ++i)
+      if (std::find(c.balls.begin(), c.balls.begin() + c.dim + 1, f.balls[static_cast<size_t>(i)]) ==
+          c.balls.begin() + c.dim + 1)
+        return false;
+    return true;
+  };
+  const auto cancel_pairs = [&](std::vector<const MixedCell*>& cells, std::vector<char>& out) {
+    for (size_t i = 0; i < cells.size(); ++i)
+      for (size_t j = 0; j < cells.size() && !out[i]; ++j)
+        if (!out[j] && i != j && (is_face(*cells[i], *cells[j]) || is_face(*cells[j], *cells[i]))) out[i] = out[j] = 1;
+  };
+  std::vector<char> renamed(came.size(), 0), gone_out(gone.size(), 0);
+  cancel_pairs(came, renamed);
+  cancel_pairs(gone, gone_out);
+  std::vector<const MixedCell*> really_gone;
+  for (size_t i = 0; i < gone.size(); ++i) {
+    const MixedCell* g = gone[i];
+    bool paired = gone_out[i];
+    for (size_t k = 0; k < came.size() && !paired; ++k)
+      if (!renamed[k] && came[k]->dim == g->dim && (came[k]->center - g->center).norm() < 0.05) {
+        renamed[k] = 1;
+        paired = true;
+      }
+    if (!paired) really_gone.push_back(g);
+  }
   const auto place = [&](const MixedCell& cell, int index, bool birth) {
     detail::TopologyChange change;
     change.point = cell.center;
@@ -219,21 +260,25 @@ void topology_changes(const SkinComplex& from, const SkinComplex& to, detail::Lo
     change.cell = index;
     local.changes.push_back(change);
   };
-  for (const auto& [balls, inside] : after) {
-    const auto was = before.find(balls);
-    if (was != before.end() && was->second == inside) continue;
-    const int c = to.find_cell(balls);
-    const MixedCell& cell = to.cell(c);
-    const bool event = was != before.end();
-    if (event && ((cell.dim == 0 && !inside) || (cell.dim == 3 && inside))) {  // a sphere vanished
-      const MixedCell& old = from.cell(from.find_cell(balls));
-      vanished.push_back({old.center, 1.0 + 2 * std::sqrt(std::abs(old.R2))});
+  for (size_t k = 0; k < came.size(); ++k) {
+    if (renamed[k]) continue;
+    const MixedCell& cell = *came[k];
+    if (same_topology) place(cell, came_index[k], false);  // a pair of critical points that cancel
+    else if (cell.dim == 3) vanished.push_back({cell.center, 1.0 + 2 * std::sqrt(std::abs(cell.R2))});
+    else place(cell, came_index[k], cell.dim == 0);
+  }
+  for (const MixedCell* g : really_gone) {
+    if (same_topology) {
+      place(*g, -1, false);
       continue;
     }
-    place(cell, c, event && (cell.dim == 0 || cell.dim == 3));
+    if (g->dim == 0) {
+      vanished.push_back({g->center, 1.0 + 2 * std::sqrt(std::abs(g->R2))});
+      continue;
+    }
+    const int now = g->dim == 3 ? to.find_cell(g->balls) : -1;
+    place(now >= 0 ? to.cell(now) : *g, now, now >= 0);
   }
-  for (const auto& [balls, inside] : before)
-    if (!after.count(balls)) place(from.cell(from.find_cell(balls)), -1, false);
 }
 
 MeshingOptions with_size_margin(MeshingOptions o, double margin) {
@@ -419,17 +464,23 @@ void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, 
   };
   long left = 0;
   // Where the topology changed; a component or void that vanished is
-  // dropped first (its sphere of triangles has no skin left to go to), and
-  // one that cannot be found as a component of its own sends the step to
-  // the whole remesh at once (edits would be wasted on it).
+  // dropped first (its sphere of triangles has no skin left to go to); one
+  // that is not a component of its own in the step before becomes a place
+  // of the local patch, whose Euler characteristic is checked.
   detail::LocalRepairOptions local;
   local.crowded_below = options_.crowded_below;
   std::vector<detail::VanishingSphere> vanished;
-  topology_changes(complex_, next, local, vanished);
+  topology_changes(complex_, next, topology == topology_, local, vanished);
   local.euler_change = topology.euler - topology_.euler;
-  const bool local_topology = vanished.empty() || drop_vanished(vanished, stayed, moved, lost, local.euler_change);
+  if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, local.euler_change))
+    for (const detail::VanishingSphere& v : vanished) {  // not a component of its own: the patch takes it
+      detail::TopologyChange change;
+      change.point = v.center;
+      change.radius = v.reach;
+      local.changes.push_back(change);
+    }
   const bool any_lost = std::find(lost.begin(), lost.end(), 1) != lost.end();
-  if (!any_lost && local_topology) {
+  if (!any_lost) {
     auto stage = Clock::now();
     std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
     left = std::count(failing.begin(), failing.end(), 1);
