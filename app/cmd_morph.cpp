@@ -50,6 +50,7 @@ struct MorphCommandOptions {
   std::vector<double> times;  // instead of --frames
   std::string align = "auto";
   std::string pairs = "auto";
+  double max_step = MovingOptions{}.max_step;  // Angstrom, --pairs matched
   std::vector<std::string> formats{"ply", "vtp"};
   MorphOptions morph;
   bool no_self_intersections = false;
@@ -76,6 +77,8 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
                  "matched (each atom one ball that travels, radius kept), all (the m x n blend of every source "
                  "and target ball), or auto (matched when both sides are one molecule, as --align auto decides)")
       ->check(CLI::IsMember({"auto", "matched", "all"}))->capture_default_str();
+  cmd.add_option("--max-step", o.max_step, "--pairs matched: largest move of an atom in one internal step, A")
+      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
   cmd.add_option("--min-angle", o.morph.frames.min_angle, "smallest angle of every triangle of every frame, degrees")
       ->check(finite_number())->check(CLI::Range(1.0, 30.0))->capture_default_str();
   cmd.add_option("--epsilon", o.morph.first.sizing.epsilon, "curvature-relative size (edge / radius of curvature)")
@@ -376,6 +379,7 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
   run.balls_of = [&](size_t k) { return motion.balls_at(times[k]); };
   for (const MatchedMotion::Track& track : motion.tracks) run.ball_atoms.push_back({track.source, track.target});
   run.options = moving_options(options);
+  run.options.max_step = o.max_step;
   run.formats = o.formats;
   run.self_intersections = !o.no_self_intersections;
   run.progress = progress;

@@ -144,6 +144,7 @@ json moving_frame_json(const FrameStats& s, const MovingCheck& c, const std::str
           {"bad_triangles_after_transport", s.bad_triangles},
           {"repaired", s.repaired},
           {"remeshed", s.remeshed},
+          {"remeshed_because", s.remeshed ? json(s.remeshed_because) : json(nullptr)},
           {"full_rebuild", s.full_rebuild},
           {"max_onsurf_error", c.max_error},
           {"oracle_uncertified", c.uncertified},

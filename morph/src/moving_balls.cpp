@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -185,7 +186,7 @@ MovedVertex move_vertex(const SkinComplex& from, const SkinComplex& to, const st
 // make the body's homotopy type, each adding (-1)^dim to its Euler
 // characteristic (Edelsbrunner 1999; docs/math.md section 6). Keyed by
 // ball tuple.
-std::unordered_map<std::array<int, 4>, int, TupleHash> inside_critical_cells(const SkinComplex& complex) {
+std::vector<int> inside_critical_cells(const SkinComplex& complex) {
   std::vector<char> critical(complex.cells().size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, critical.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t c = r.begin(); c != r.end(); ++c) {
@@ -194,9 +195,15 @@ std::unordered_map<std::array<int, 4>, int, TupleHash> inside_critical_cells(con
                     complex.membership_violation(static_cast<int>(c), cell.center) <= 0;
     }
   });
-  std::unordered_map<std::array<int, 4>, int, TupleHash> out;
+  std::vector<int> out;
   for (size_t c = 0; c < critical.size(); ++c)
-    if (critical[c]) out.emplace(complex.cells()[c].balls, static_cast<int>(c));
+    if (critical[c]) out.push_back(static_cast<int>(c));
+  return out;
+}
+
+std::unordered_map<std::array<int, 4>, int, TupleHash> by_tuple(const SkinComplex& complex, const std::vector<int>& cells) {
+  std::unordered_map<std::array<int, 4>, int, TupleHash> out;
+  for (int c : cells) out.emplace(complex.cell(c).balls, c);
   return out;
 }
 
@@ -210,9 +217,10 @@ std::unordered_map<std::array<int, 4>, int, TupleHash> inside_critical_cells(con
 // in the step before: its component is dropped before the repair
 // (vanishing.hpp). When the counts did not change (`same_topology`), the
 // places are pairs of critical points that cancel: no birth, nothing vanished.
-void topology_changes(const SkinComplex& from, const SkinComplex& to, bool same_topology,
-                      detail::LocalRepairOptions& local, std::vector<detail::VanishingSphere>& vanished) {
-  const auto before = inside_critical_cells(from), after = inside_critical_cells(to);
+void topology_changes(const SkinComplex& from, const std::vector<int>& from_critical, const SkinComplex& to,
+                      const std::vector<int>& to_critical, bool same_topology, detail::LocalRepairOptions& local,
+                      std::vector<detail::VanishingSphere>& vanished) {
+  const auto before = by_tuple(from, from_critical), after = by_tuple(to, to_critical);
   std::vector<const MixedCell*> gone, came;
   std::vector<int> came_index;
   for (const auto& [balls, c] : before)
@@ -337,6 +345,7 @@ MovingBalls::MovingBalls(std::vector<Ball> balls, const MovingOptions& options, 
   const auto start = Clock::now();
   complex_ = build_skin_complex(std::move(balls), {options.shrink});
   topology_ = skin_topology(complex_.balls());
+  critical_ = inside_critical_cells(complex_);
   frame_.stats.seconds_complex = seconds_since(start);
   const auto mesh_start = Clock::now();
   SkinMeshResult made = mesh_skin(complex_, with_size_margin(options.first, options.first_size_margin));
@@ -411,7 +420,12 @@ void MovingBalls::step(std::vector<Ball> balls) {
   FrameStats& s = frame_.stats;
   auto stage = Clock::now();
   SkinComplex next = build_skin_complex(std::move(balls), {options_.shrink});
-  const SkinTopology topology = skin_topology(next.balls());
+  // The certificate's count (CGAL's alpha shape, serial) runs beside the
+  // rest of the step and is waited for before the repair.
+  SkinTopology topology;
+  tbb::task_group counting;
+  counting.run([&] { topology = skin_topology(next.balls()); });
+  std::vector<int> critical = inside_critical_cells(next);
   const std::vector<Eigen::Matrix3d> rotations = neighbourhood_rotations(complex_, next.balls());
   s.seconds_complex += seconds_since(stage);
   stage = Clock::now();
@@ -447,92 +461,24 @@ void MovingBalls::step(std::vector<Ball> balls) {
     }
   }
   s.seconds_transport += seconds_since(stage);
-  repair(next, topology, moved, lost, stayed);
+  stage = Clock::now();
+  counting.wait();
+  s.seconds_complex += seconds_since(stage);
+  repair(next, topology, critical, moved, lost, stayed);
   complex_ = std::move(next);
   topology_ = topology;
+  critical_ = std::move(critical);
 }
 
 // The moved step made the frame: kept as it is, or mended, cheapest first
 // (moving_balls.hpp); throws Error when no mesh of the step can be certified.
-void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, SurfaceMesh& moved,
-                         std::vector<char>& lost, const std::vector<char>& stayed) {
+void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
+                         SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed) {
+  const std::string because = mend_locally(next, topology, critical, moved, lost, stayed);
+  if (because.empty()) return;
   FrameStats& s = frame_.stats;
-  const auto follow = [&](const std::vector<long>& origin) {  // the frame's ids onto an edited mesh's vertices
-    std::vector<long> ids(origin.size());
-    for (size_t v = 0; v < ids.size(); ++v) ids[v] = origin[v] >= 0 ? frame_.ids[static_cast<size_t>(origin[v])] : next_id_++;
-    frame_.ids = std::move(ids);
-  };
-  long left = 0;
-  // Where the topology changed; a component or void that vanished is
-  // dropped first (its sphere of triangles has no skin left to go to); one
-  // that is not a component of its own in the step before becomes a place
-  // of the local patch, whose Euler characteristic is checked.
-  detail::LocalRepairOptions local;
-  local.crowded_below = options_.crowded_below;
-  std::vector<detail::VanishingSphere> vanished;
-  topology_changes(complex_, next, topology == topology_, local, vanished);
-  local.euler_change = topology.euler - topology_.euler;
-  if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, local.euler_change))
-    for (const detail::VanishingSphere& v : vanished) {  // not a component of its own: the patch takes it
-      detail::TopologyChange change;
-      change.point = v.center;
-      change.radius = v.reach;
-      local.changes.push_back(change);
-    }
-  const bool any_lost = std::find(lost.begin(), lost.end(), 1) != lost.end();
-  if (!any_lost) {
-    auto stage = Clock::now();
-    std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
-    left = std::count(failing.begin(), failing.end(), 1);
-    s.bad_triangles += left;
-    s.seconds_judge += seconds_since(stage);
-    if (left > 0 && options_.relaxation.passes > 0) {
-      stage = Clock::now();
-      std::vector<char> corners(moved.vertices.size(), 0);
-      for (size_t f = 0; f < failing.size(); ++f)
-        if (failing[f])
-          for (int v : moved.triangles[f]) corners[static_cast<size_t>(v)] = 1;
-      relax_tangentially(next, moved, options_.relaxation, &corners);
-      s.seconds_relax += seconds_since(stage);
-      stage = Clock::now();
-      failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
-      left = std::count(failing.begin(), failing.end(), 1);
-      s.seconds_judge += seconds_since(stage);
-    }
-    stage = Clock::now();
-    if (left > 0 && options_.edits) {
-      detail::Surgery edited = detail::mend_by_edits(next, std::move(moved), failing, options_.frames, {}, &frame_.ids,
-                                                     &refused_thinning_);
-      follow(edited.origin);
-      moved = std::move(edited.mesh);
-      failing = std::move(edited.failing);
-      left = edited.left;
-      s.split += edited.splits;
-      s.flipped += edited.flips;
-      s.contracted += edited.contractions;
-      s.repaired = true;
-    }
-    if ((left > 0 || !local.changes.empty()) &&
-        left <= options_.local_repair_share * static_cast<double>(failing.size())) {
-      detail::LocalRepair patched = detail::repair_locally(next, moved, failing, repair_criteria(), options_.frames, local);
-      if (patched.ok) {
-        follow(patched.origin);
-        moved = std::move(patched.mesh);
-        left = 0;
-        s.repaired = true;
-        s.patch_triangles += patched.patch_triangles;
-        s.repairs += patched.repairs;
-      }
-    }
-    s.seconds_repair += seconds_since(stage);
-    if (left == 0 && mesh_topology(moved) == topology) {
-      frame_.mesh = std::move(moved);
-      s.topology_certified = true;
-      return;
-    }
-  }
+  s.remeshed_because = because;
   const auto stage = Clock::now();
-  if (!any_lost) lost.assign(moved.vertices.size(), 0);  // the edits may have renumbered the vertices
   s.crowded += detail::mark_crowded(next, moved, options_.frames, options_.crowded_below, lost);
   const bool remeshed = remesh(next, moved, lost, repair_criteria());
   if (!remeshed || mesh_topology(frame_.mesh) != topology) {
@@ -551,6 +497,96 @@ void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, 
     throw Error("moving balls: a step's mesh has " + made.text() + " where the skin has " + topology.text() +
                 "; the frame is refused");
   s.topology_certified = true;
+}
+
+// Judging, relaxation, edits and a local patch (moving_balls.hpp). Returns
+// "" when they made a certified frame, else why the step must be remeshed
+// whole; `moved` and `lost` are then the mesh to remesh from and its lost
+// vertices.
+std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopology& topology,
+                                      const std::vector<int>& critical, SurfaceMesh& moved, std::vector<char>& lost,
+                                      const std::vector<char>& stayed) {
+  FrameStats& s = frame_.stats;
+  const auto follow = [&](const std::vector<long>& origin) {  // the frame's ids onto an edited mesh's vertices
+    std::vector<long> ids(origin.size());
+    for (size_t v = 0; v < ids.size(); ++v) ids[v] = origin[v] >= 0 ? frame_.ids[static_cast<size_t>(origin[v])] : next_id_++;
+    frame_.ids = std::move(ids);
+  };
+  // Where the topology changed; a component or void that vanished is
+  // dropped first (its sphere of triangles has no skin left to go to); one
+  // that is not a component of its own in the step before becomes a place
+  // of the local patch, whose Euler characteristic is checked.
+  detail::LocalRepairOptions local;
+  local.crowded_below = options_.crowded_below;
+  std::vector<detail::VanishingSphere> vanished;
+  topology_changes(complex_, critical_, next, critical, topology == topology_, local, vanished);
+  local.euler_change = topology.euler - topology_.euler;
+  if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, local.euler_change))
+    for (const detail::VanishingSphere& v : vanished) {  // not a component of its own: the patch takes it
+      detail::TopologyChange change;
+      change.point = v.center;
+      change.radius = v.reach;
+      local.changes.push_back(change);
+    }
+  const long lost_count = std::count(lost.begin(), lost.end(), 1);
+  if (lost_count > 0) return std::to_string(lost_count) + " vertices could not be put on the new skin";
+  auto stage = Clock::now();
+  std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+  long left = std::count(failing.begin(), failing.end(), 1);
+  s.bad_triangles += left;
+  s.seconds_judge += seconds_since(stage);
+  if (left > 0 && options_.relaxation.passes > 0) {
+    stage = Clock::now();
+    std::vector<char> corners(moved.vertices.size(), 0);
+    for (size_t f = 0; f < failing.size(); ++f)
+      if (failing[f])
+        for (int v : moved.triangles[f]) corners[static_cast<size_t>(v)] = 1;
+    relax_tangentially(next, moved, options_.relaxation, &corners);
+    s.seconds_relax += seconds_since(stage);
+    stage = Clock::now();
+    failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+    left = std::count(failing.begin(), failing.end(), 1);
+    s.seconds_judge += seconds_since(stage);
+  }
+  stage = Clock::now();
+  if (left > 0 && options_.edits) {
+    detail::Surgery edited =
+        detail::mend_by_edits(next, std::move(moved), failing, options_.frames, {}, &frame_.ids, &refused_thinning_);
+    follow(edited.origin);
+    moved = std::move(edited.mesh);
+    failing = std::move(edited.failing);
+    left = edited.left;
+    s.split += edited.splits;
+    s.flipped += edited.flips;
+    s.contracted += edited.contractions;
+    s.repaired = true;
+  }
+  lost.assign(moved.vertices.size(), 0);  // the edits renumbered the vertices; none is lost
+  std::string because;
+  const double share = options_.local_repair_share * static_cast<double>(failing.size());
+  if (left > share) {
+    because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
+              std::to_string(static_cast<long>(share)) + ")";
+  } else if (left > 0 || !local.changes.empty()) {
+    detail::LocalRepair patched = detail::repair_locally(next, moved, failing, repair_criteria(), options_.frames, local);
+    if (patched.ok) {
+      follow(patched.origin);
+      moved = std::move(patched.mesh);
+      lost.assign(moved.vertices.size(), 0);
+      s.repaired = true;
+      s.patch_triangles += patched.patch_triangles;
+      s.repairs += patched.repairs;
+    } else {
+      because = "the local patch failed (its seam, its criteria or its Euler characteristic)";
+    }
+  }
+  s.seconds_repair += seconds_since(stage);
+  if (!because.empty()) return because;
+  const SkinTopology made = mesh_topology(moved);
+  if (made != topology) return "the mended mesh has " + made.text() + ", the skin " + topology.text();
+  frame_.mesh = std::move(moved);
+  s.topology_certified = true;
+  return "";
 }
 
 // The components of the step before that `vanished` took (vanishing.hpp),

@@ -42,6 +42,7 @@
 #include <array>
 #include <functional>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -128,6 +129,7 @@ struct FrameStats {
   double ids_kept = 0;         // share of the frame's vertices whose id the frame before had
   double max_kept_move = 0;    // largest move of a vertex whose id was kept, since the frame before (Angstrom)
   bool topology_certified = false;  // components, voids and Euler characteristic equal the skin's (skin_topology)
+  std::string remeshed_because;     // why the last step remeshed whole was not mended locally ("" when none was)
   // Where the frame's time went (seconds; docs/morph.md, "Where a frame's
   // time goes"). The stages do not overlap; their sum falls short of
   // `seconds` by the bookkeeping between them and by the wait for the

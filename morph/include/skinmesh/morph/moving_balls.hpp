@@ -34,6 +34,7 @@
 #include "skinmesh/morph/relaxation.hpp"
 
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -93,8 +94,10 @@ class MovingBalls {
 
  private:
   void step(std::vector<Ball> balls);
-  void repair(const SkinComplex& next, const SkinTopology& topology, SurfaceMesh& moved, std::vector<char>& lost,
-              const std::vector<char>& stayed);
+  void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
+              SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
+  std::string mend_locally(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
+                           SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
                      SurfaceMesh& moved, std::vector<char>& lost, long& euler_change);
   bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
@@ -103,6 +106,7 @@ class MovingBalls {
   MovingOptions options_;
   SkinComplex complex_;
   SkinTopology topology_;
+  std::vector<int> critical_;  // cells of complex_ that are critical points inside the body (moving_balls.cpp)
   MorphFrame frame_;
   long next_id_ = 0;
   std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;  // detail::RefusedEdges
