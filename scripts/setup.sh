@@ -18,6 +18,8 @@ packages=(
   libcli11-dev                                      # command line
   nlohmann-json3-dev                                # JSON reports
   robin-map-dev                                     # flat hash map (the morph's mesh edits)
+  pybind11-dev python3-dev python3-numpy            # the Python module (docs/python.md)
+  python3-pytest python3-meshio python3-mdanalysis  # its tests: pytest, meshio, MD trajectories
 )
 
 source "$here/scripts/install-packages.sh"
@@ -27,3 +29,8 @@ launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}"
 cmake --build "$here/build" -j "$(nproc)"
+
+# /usr/bin/python3 finds the module built into build/python (docs/python.md).
+if [ -d "$here/build/python/skinmesh" ] && [ -w /usr/lib/python3/dist-packages ]; then
+  echo "$here/build/python" > /usr/lib/python3/dist-packages/skinmesh-build.pth
+fi

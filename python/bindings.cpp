@@ -1,0 +1,501 @@
+// skinmesh for Python (pybind11): molecules or balls in, numpy arrays out
+// (docs/python.md). Vertices are (n, 3) float64 arrays that take over the
+// library's memory without a copy; triangles (m, 3) int64; per-vertex
+// attributes a dict of arrays; reports dicts (the JSON the command writes).
+// Long calls release the GIL; errors are Python exceptions, InputError
+// keeping the file and the line.
+#include "quality_report.hpp"
+
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_topology.hpp"
+#include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/alignment.hpp"
+#include "skinmesh/morph/matched_motion.hpp"
+#include "skinmesh/morph/morph.hpp"
+#include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/quality/guarantees.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+using namespace skinmesh;
+
+namespace {
+
+// ---- arrays ----------------------------------------------------------------
+
+// The vertices handed over to numpy: the vector moves into a capsule that
+// numpy frees with the array (Eigen::Vector3d is three packed doubles).
+py::array_t<double> vertex_array(std::vector<Eigen::Vector3d> points) {
+  auto* held = new std::vector<Eigen::Vector3d>(std::move(points));
+  const py::capsule owner(held, [](void* p) { delete static_cast<std::vector<Eigen::Vector3d>*>(p); });
+  const auto n = static_cast<py::ssize_t>(held->size());
+  return py::array_t<double>({n, py::ssize_t{3}}, {py::ssize_t{3 * sizeof(double)}, py::ssize_t{sizeof(double)}},
+                             held->empty() ? nullptr : held->front().data(), owner);
+}
+
+py::array_t<std::int64_t> triangle_array(const std::vector<std::array<int, 3>>& triangles) {
+  py::array_t<std::int64_t> out({static_cast<py::ssize_t>(triangles.size()), py::ssize_t{3}});
+  auto view = out.mutable_unchecked<2>();
+  for (size_t f = 0; f < triangles.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) view(static_cast<py::ssize_t>(f), static_cast<py::ssize_t>(k)) = triangles[f][k];
+  return out;
+}
+
+template <class T, class Out = T>
+py::array_t<Out> array_of(const std::vector<T>& values) {
+  py::array_t<Out> out(static_cast<py::ssize_t>(values.size()));
+  auto view = out.template mutable_unchecked<1>();
+  for (size_t i = 0; i < values.size(); ++i) view(static_cast<py::ssize_t>(i)) = static_cast<Out>(values[i]);
+  return out;
+}
+
+std::vector<Eigen::Vector3d> points_from(const py::array_t<double, py::array::c_style | py::array::forcecast>& a,
+                                         const char* what) {
+  if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string(what) + " must be an (n, 3) array");
+  std::vector<Eigen::Vector3d> out(static_cast<size_t>(a.shape(0)));
+  const auto view = a.unchecked<2>();
+  for (py::ssize_t i = 0; i < a.shape(0); ++i) out[static_cast<size_t>(i)] = {view(i, 0), view(i, 1), view(i, 2)};
+  return out;
+}
+
+SurfaceMesh mesh_from(const py::array_t<double, py::array::c_style | py::array::forcecast>& vertices,
+                      const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& triangles) {
+  SurfaceMesh mesh;
+  mesh.vertices = points_from(vertices, "vertices");
+  if (triangles.ndim() != 2 || triangles.shape(1) != 3) throw py::value_error("triangles must be an (m, 3) array");
+  const auto view = triangles.unchecked<2>();
+  for (py::ssize_t f = 0; f < triangles.shape(0); ++f) {
+    std::array<int, 3> t{};
+    for (py::ssize_t k = 0; k < 3; ++k) {
+      const std::int64_t v = view(f, k);
+      if (v < 0 || v >= static_cast<std::int64_t>(mesh.vertices.size()))
+        throw py::value_error("triangle " + std::to_string(f) + " uses vertex " + std::to_string(v) +
+                              ", not one of the " + std::to_string(mesh.vertices.size()));
+      t[static_cast<size_t>(k)] = static_cast<int>(v);
+    }
+    mesh.triangles.push_back(t);
+  }
+  return mesh;
+}
+
+py::object json_to_python(const nlohmann::json& j) {
+  return py::module_::import("json").attr("loads")(j.dump());
+}
+
+// ---- options ---------------------------------------------------------------
+
+// Keyword options with the command line's names (dashes as underscores)
+// and defaults; an unknown name is an error, as on the command line.
+struct Options {
+  py::dict given;
+  std::vector<std::string> used;
+  template <class T>
+  T get(const char* name, T fallback) {
+    used.emplace_back(name);
+    return given.contains(name) ? given[name].cast<T>() : fallback;
+  }
+  void finish() const {
+    for (const auto& item : given) {
+      const std::string key = item.first.cast<std::string>();
+      if (std::find(used.begin(), used.end(), key) == used.end()) throw py::type_error("unknown option '" + key + "'");
+    }
+  }
+};
+
+struct BallSource {
+  std::vector<Ball> balls;
+  std::optional<Molecule> molecule;  // when read from a file
+};
+
+WeightConvention convention_of(const std::string& weights) {
+  if (weights == "grow") return WeightConvention::GrowBySkin;
+  if (weights == "raw") return WeightConvention::Raw;
+  throw py::value_error("weights must be 'grow' or 'raw', not '" + weights + "'");
+}
+
+// A path, or a tuple (centres (n, 3), radii (n,)).
+BallSource balls_from(const py::object& source, Options& o, double shrink) {
+  const WeightConvention convention = convention_of(o.get<std::string>("weights", "grow"));
+  BallSource out;
+  if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
+    ReadOptions read;
+    read.model = o.get<int>("model", 1);
+    read.keep_hydrogens = o.get<bool>("keep_hydrogens", false);
+    read.keep_waters = o.get<bool>("keep_waters", false);
+    read.chains = o.get<std::vector<std::string>>("chain", {});
+    read.unknown_radius = o.get<double>("unknown_radius", read.unknown_radius);
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(source));
+    out.molecule = read_molecule(path, read);
+    if (out.molecule->atoms.empty()) input_error(path, 0, "no atoms left to mesh");
+    out.balls = balls_from_molecule(*out.molecule, shrink, convention);
+    return out;
+  }
+  const auto pair = source.cast<py::tuple>();
+  if (pair.size() != 2) throw py::value_error("source must be a path or a tuple (centres, radii)");
+  const std::vector<Eigen::Vector3d> centres = points_from(pair[0].cast<py::array_t<double, py::array::c_style | py::array::forcecast>>(), "centres");
+  const auto radii = pair[1].cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
+  if (radii.ndim() != 1 || static_cast<size_t>(radii.shape(0)) != centres.size())
+    throw py::value_error("radii must be an (n,) array, one per centre");
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const double r = radii.at(static_cast<py::ssize_t>(i));
+    out.balls.push_back({centres[i], convention == WeightConvention::GrowBySkin ? r * r / shrink : r * r});
+  }
+  return out;
+}
+
+MeshingOptions meshing_options(Options& o, double default_angle) {
+  MeshingOptions m;
+  m.min_angle = o.get<double>("min_angle", default_angle);
+  m.sizing.epsilon = o.get<double>("epsilon", m.sizing.epsilon);
+  m.edge_length = o.get<double>("edge_length", 0.0);
+  m.tolerance = o.get<double>("tolerance", m.tolerance);
+  m.max_triangles = o.get<long>("max_triangles", m.max_triangles);
+  m.threads = o.get<int>("threads", 0);
+  return m;
+}
+
+// ---- results ---------------------------------------------------------------
+
+struct MeshResult {
+  py::array_t<double> vertices;
+  py::array_t<std::int64_t> triangles;
+  py::dict attributes;
+  py::object report;
+};
+
+struct Frame {
+  py::array_t<double> vertices;
+  py::array_t<std::int64_t> triangles;
+  py::array_t<std::int64_t> ids;
+  py::dict attributes;
+  py::object report;
+};
+
+nlohmann::json stats_json(const FrameStats& s) {
+  return {{"t", s.t},
+          {"vertices", s.vertices},
+          {"triangles", s.triangles},
+          {"moved", s.moved},
+          {"relocated", s.relocated},
+          {"inserted", s.inserted},
+          {"removed", s.removed},
+          {"steps", s.steps},
+          {"reidentified", s.reidentified},
+          {"ids_kept", s.ids_kept},
+          {"max_kept_move", s.max_kept_move},
+          {"repaired", s.repaired},
+          {"remeshed", s.remeshed},
+          {"remeshed_because", s.remeshed_because},
+          {"full_rebuild", s.full_rebuild},
+          {"topology_certified", s.topology_certified},
+          {"seconds", s.seconds}};
+}
+
+// A frame: mesh arrays, ids, per-vertex atoms, and its stats and grade.
+Frame frame_of(const MorphFrame& f, const std::vector<int>& atom, const std::vector<int>& patch, double min_angle,
+               const std::vector<Ball>* balls, double shrink) {
+  Frame out;
+  out.triangles = triangle_array(f.mesh.triangles);
+  out.ids = array_of<long, std::int64_t>(f.ids);
+  out.attributes["atom"] = array_of<int, std::int64_t>(atom);
+  out.attributes["patch"] = array_of<int, std::int64_t>(patch);
+  out.attributes["normals"] = vertex_array(f.mesh.normals);
+  nlohmann::json report = stats_json(f.stats);
+  if (balls) {
+    GuaranteeOptions bounds;
+    bounds.min_angle = min_angle;
+    bounds.on_skin_tolerance = 1e-8;
+    const GuaranteeReport g = check_guarantees(f.mesh, *balls, shrink, bounds);
+    const SkinTopology skin = skin_topology(*balls);
+    report["quality"] = app::to_json(g.quality);
+    report["on_surface_error"] = app::to_json(g.surface_error);
+    report["guarantees"] = {
+        {"min_angle_at_least_bound", g.angle},
+        {"vertices_on_skin", g.on_skin},
+        {"on_skin_tolerance", bounds.on_skin_tolerance},
+        {"closed_oriented_manifold", g.closed_oriented_manifold},
+        {"no_self_intersections", g.no_self_intersections.value_or(false)},
+        {"topology", g.quality.components == skin.components && g.quality.cavities == skin.voids &&
+                         g.quality.euler == skin.euler}};
+  }
+  out.vertices = vertex_array(f.mesh.vertices);
+  out.report = json_to_python(report);
+  return out;
+}
+
+// ---- calls -----------------------------------------------------------------
+
+MeshResult mesh(const py::object& source, const py::kwargs& kwargs) {
+  Options o{kwargs.cast<py::dict>(), {}};
+  const double shrink = o.get<double>("shrink", 0.5);
+  BallSource in = balls_from(source, o, shrink);
+  MeshingOptions m = meshing_options(o, 30.0);
+  const bool self_intersections = !o.get<bool>("no_self_intersections", false);
+  const py::object progress = o.get<py::object>("progress", py::none());
+  o.finish();
+  if (!progress.is_none())
+    m.progress = [progress](const MeshingProgress& p) {
+      py::gil_scoped_acquire gil;
+      progress(std::string(p.stage), p.vertices, p.expected_vertices);
+    };
+  SkinMeshResult made;
+  GuaranteeReport g;
+  std::vector<int> atom, patch;
+  nlohmann::json seconds;
+  {
+    py::gil_scoped_release release;
+    const auto start = Clock::now();
+    const SkinComplex complex = build_skin_complex(in.balls, {shrink});
+    seconds["complex"] = seconds_since(start);
+    made = mesh_skin(complex, m);
+    seconds["meshing"] = made.stats.seconds_total;
+    if (made.status == MeshingStatus::ok) {
+      GuaranteeOptions bounds;
+      bounds.min_angle = m.min_angle;
+      bounds.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
+      g = check_guarantees(made.mesh, in.balls, shrink, bounds);
+      for (size_t v = 0; v < made.mesh.vertices.size(); ++v) {
+        patch.push_back(complex.cell(made.mesh.cells[v]).dim);
+        atom.push_back(complex.owning_ball(made.mesh.vertices[v], made.mesh.cells[v]));
+      }
+    }
+  }
+  if (made.status == MeshingStatus::empty_skin) throw py::value_error(made.message);
+  if (made.status != MeshingStatus::ok) throw std::runtime_error(made.message);
+  if (!g.all_hold()) throw std::runtime_error("the mesh fails a guarantee: " + app::guarantees_json(g).dump());
+  nlohmann::json report = {{"atoms", in.balls.size()},
+                           {"shrink", shrink},
+                           {"quality", app::to_json(g.quality)},
+                           {"on_surface_error", app::to_json(g.surface_error)},
+                           {"guarantees", app::guarantees_json(g)},
+                           {"seconds", seconds}};
+  MeshResult out;
+  out.triangles = triangle_array(made.mesh.triangles);
+  out.attributes["atom"] = array_of<int, std::int64_t>(atom);
+  out.attributes["patch"] = array_of<int, std::int64_t>(patch);
+  out.attributes["normals"] = vertex_array(std::move(made.mesh.normals));
+  out.vertices = vertex_array(std::move(made.mesh.vertices));
+  out.report = json_to_python(report);
+  return out;
+}
+
+py::object grade(const py::array_t<double, py::array::c_style | py::array::forcecast>& vertices,
+                 const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& triangles) {
+  const SurfaceMesh m = mesh_from(vertices, triangles);
+  MeshQuality q;
+  {
+    py::gil_scoped_release release;
+    q = grade_mesh(m);
+  }
+  return json_to_python(app::to_json(q));
+}
+
+// Moving balls fed centres call by call (morph/moving_balls.hpp): the first
+// call meshes, every later one carries the mesh on.
+class PyMovingBalls {
+ public:
+  PyMovingBalls(const py::array_t<double, py::array::c_style | py::array::forcecast>& radii, const py::kwargs& kwargs) {
+    Options o{kwargs.cast<py::dict>(), {}};
+    options_.shrink = o.get<double>("shrink", 0.5);
+    const WeightConvention convention = convention_of(o.get<std::string>("weights", "grow"));
+    options_.first = meshing_options(o, 30.0);
+    options_.frames = options_.first;
+    options_.frames.min_angle = std::min(options_.first.min_angle, 20.0);
+    options_.first.min_angle = 30.0;
+    options_.max_step = o.get<double>("max_step", options_.max_step);
+    check_ = o.get<bool>("check", true);
+    o.finish();
+    if (radii.ndim() != 1) throw py::value_error("radii must be an (n,) array");
+    for (py::ssize_t i = 0; i < radii.shape(0); ++i) {
+      const double r = radii.at(i);
+      weights_.push_back(convention == WeightConvention::GrowBySkin ? r * r / options_.shrink : r * r);
+    }
+  }
+  Frame advance_to(const py::array_t<double, py::array::c_style | py::array::forcecast>& centres, double t) {
+    const std::vector<Eigen::Vector3d> points = points_from(centres, "centres");
+    if (points.size() != weights_.size())
+      throw py::value_error("centres has " + std::to_string(points.size()) + " rows, radii " +
+                            std::to_string(weights_.size()));
+    std::vector<Ball> balls(points.size());
+    for (size_t i = 0; i < balls.size(); ++i) balls[i] = {points[i], weights_[i]};
+    std::vector<int> atom, patch;
+    {
+      py::gil_scoped_release release;
+      if (!engine_) engine_ = std::make_unique<MovingBalls>(std::move(balls), options_, t);
+      else engine_->advance_to(std::move(balls), t);
+      atom = engine_->vertex_balls();
+      for (int c : engine_->frame().mesh.cells) patch.push_back(engine_->complex().cell(c).dim);
+    }
+    const std::vector<Ball>& now = engine_->balls();
+    return frame_of(engine_->frame(), atom, patch, options_.frames.min_angle, check_ ? &now : nullptr,
+                    options_.shrink);
+  }
+
+ private:
+  MovingOptions options_;
+  std::vector<double> weights_;
+  bool check_ = true;
+  std::unique_ptr<MovingBalls> engine_;
+};
+
+// A morph from a source to a target: pairs "matched" (atoms travel) or
+// "all" (the m x n blend), "auto" as the command decides.
+class PyMorph {
+ public:
+  PyMorph(const py::object& source, const py::object& target, const py::kwargs& kwargs) {
+    Options o{kwargs.cast<py::dict>(), {}};
+    shrink_ = o.get<double>("shrink", 0.5);
+    const std::string pairs = o.get<std::string>("pairs", "auto");
+    const std::string how = o.get<std::string>("align", "auto");
+    MorphOptions m;
+    m.shrink = shrink_;
+    m.first = meshing_options(o, 30.0);
+    m.frames = m.first;
+    m.frames.min_angle = std::min(m.first.min_angle, 20.0);
+    m.first.min_angle = 30.0;
+    min_angle_ = m.frames.min_angle;
+    check_ = o.get<bool>("check", true);
+    const WeightConvention convention = convention_of(o.get<std::string>("weights", "grow"));
+    Options target_options{o.given, o.used};
+    BallSource a = balls_from(source, o, shrink_);
+    BallSource b = balls_from(target, target_options, shrink_);
+    o.finish();
+    if (a.molecule && b.molecule) {
+      const std::map<std::string, AlignmentMethod> methods{{"auto", AlignmentMethod::automatic},
+                                                           {"none", AlignmentMethod::none},
+                                                           {"centroid", AlignmentMethod::centroid},
+                                                           {"kabsch", AlignmentMethod::kabsch}};
+      if (!methods.count(how)) throw py::value_error("align must be auto, none, centroid or kabsch");
+      *b.molecule = moved(std::move(*b.molecule), align(*a.molecule, *b.molecule, methods.at(how)).motion);
+      snap_unmoved(*a.molecule, *b.molecule);
+      b.balls = balls_from_molecule(*b.molecule, shrink_, convention);
+      a.balls = balls_from_molecule(*a.molecule, shrink_, convention);
+    }
+    matched_ = pairs == "matched" || (pairs == "auto" && a.molecule && b.molecule && same_molecule(*a.molecule, *b.molecule));
+    if (matched_ && !(a.molecule && b.molecule)) throw py::value_error("pairs='matched' needs two molecule files");
+    py::gil_scoped_release release;
+    if (matched_) {
+      motion_ = match_motion(*a.molecule, a.balls, *b.molecule, b.balls);
+      for (const auto& track : motion_.tracks) ball_atoms_.push_back({track.source, track.target});
+      moving_ = std::make_unique<MovingBalls>(motion_.balls_at(0), moving_options(m), 0.0);
+    } else {
+      morph_ = std::make_unique<Morph>(prepare_morph(a.balls, b.balls, 0.0, m));
+      source_ = a.balls;
+      target_ = b.balls;
+    }
+  }
+  Frame frame() { return current(); }
+  Frame advance_to(double t) {
+    {
+      py::gil_scoped_release release;
+      if (matched_) moving_->advance_to(motion_.balls_at(t), t);
+      else morph_->advance_to(t);
+    }
+    return current();
+  }
+  bool matched() const { return matched_; }
+
+ private:
+  static MovingOptions moving_options(const MorphOptions& m) {
+    MovingOptions o;
+    o.shrink = m.shrink;
+    o.first = m.first;
+    o.frames = m.frames;
+    return o;
+  }
+  Frame current() {
+    std::vector<int> atom, patch;
+    if (matched_) {
+      for (int ball : moving_->vertex_balls()) atom.push_back(ball_atoms_[static_cast<size_t>(ball)][0]);
+      for (int c : moving_->frame().mesh.cells) patch.push_back(moving_->complex().cell(c).dim);
+      Frame f = frame_of(moving_->frame(), atom, patch, min_angle_, check_ ? &moving_->balls() : nullptr, shrink_);
+      std::vector<int> target_atom;
+      for (int ball : moving_->vertex_balls()) target_atom.push_back(ball_atoms_[static_cast<size_t>(ball)][1]);
+      f.attributes["target_atom"] = array_of<int, std::int64_t>(target_atom);
+      return f;
+    }
+    std::vector<int> target_atom;
+    for (const auto& pair : morph_->vertex_atoms()) {
+      atom.push_back(pair[0]);
+      target_atom.push_back(pair[1]);
+    }
+    for (int c : morph_->frame().mesh.cells) patch.push_back(morph_->complex().cell(c).dim);
+    // The blend's balls as a static set: the ends' own, the live pairs' in between.
+    const double t = morph_->t();
+    const std::vector<Ball> balls =
+        t == 0 ? source_ : t == 1 ? target_ : interpolated_balls(source_, target_, morph_->pairs(), t);
+    Frame f = frame_of(morph_->frame(), atom, patch, min_angle_, check_ ? &balls : nullptr, shrink_);
+    f.attributes["target_atom"] = array_of<int, std::int64_t>(target_atom);
+    return f;
+  }
+
+  double shrink_ = 0.5, min_angle_ = 20;
+  bool check_ = true, matched_ = false;
+  MatchedMotion motion_;
+  std::vector<std::array<int, 2>> ball_atoms_;
+  std::unique_ptr<MovingBalls> moving_;
+  std::unique_ptr<Morph> morph_;
+  std::vector<Ball> source_, target_;
+};
+
+}  // namespace
+
+PYBIND11_MODULE(_skinmesh, m) {
+  m.doc() = "skinmesh: quality meshes of molecular skin surfaces, and morphs (docs/python.md)";
+  m.attr("__version__") = SKINMESH_VERSION;
+  static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
+  static py::exception<InputError> input(m, "InputError", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      py::object instance = py::reinterpret_borrow<py::object>(input.ptr())(e.what());
+      instance.attr("file") = e.file();
+      instance.attr("line") = e.line();
+      PyErr_SetObject(input.ptr(), instance.ptr());
+    } catch (const ContractError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const Error& e) {
+      PyErr_SetString(error.ptr(), e.what());
+    }
+  });
+
+  py::class_<MeshResult>(m, "Mesh")
+      .def_readonly("vertices", &MeshResult::vertices)
+      .def_readonly("triangles", &MeshResult::triangles)
+      .def_readonly("attributes", &MeshResult::attributes)
+      .def_readonly("report", &MeshResult::report);
+  py::class_<Frame>(m, "Frame")
+      .def_readonly("vertices", &Frame::vertices)
+      .def_readonly("triangles", &Frame::triangles)
+      .def_readonly("ids", &Frame::ids)
+      .def_readonly("attributes", &Frame::attributes)
+      .def_readonly("report", &Frame::report);
+  m.def("mesh", &mesh, py::arg("source"),
+        "Quality mesh of the skin of a molecule file or of (centres, radii); options as on the command line.");
+  m.def("grade", &grade, py::arg("vertices"), py::arg("triangles"), "The quality report of any triangle mesh.");
+  py::class_<PyMovingBalls>(m, "MovingBalls")
+      .def(py::init<const py::array_t<double, py::array::c_style | py::array::forcecast>&, const py::kwargs&>(),
+           py::arg("radii"))
+      .def("advance_to", &PyMovingBalls::advance_to, py::arg("centres"), py::arg("t") = 0.0,
+           "The frame of the balls at these centres (the first call meshes, later ones carry the mesh on).");
+  py::class_<PyMorph>(m, "Morph")
+      .def(py::init<const py::object&, const py::object&, const py::kwargs&>(), py::arg("source"), py::arg("target"))
+      .def_property_readonly("frame", &PyMorph::frame)
+      .def_property_readonly("matched", &PyMorph::matched)
+      .def("advance_to", &PyMorph::advance_to, py::arg("t"));
+}

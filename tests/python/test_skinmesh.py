@@ -1,0 +1,156 @@
+"""The Python module against the command and the library's own checks.
+
+Run by ctest (python_module) with PYTHONPATH at build/python, or by hand:
+    PYTHONPATH=build/python /usr/bin/python3 -m pytest tests/python
+"""
+import json
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import skinmesh
+
+DATA = os.environ.get("SKINMESH_DATA_DIR", os.path.join(os.path.dirname(__file__), "..", "..", "data"))
+BINARY = os.environ.get("SKINMESH_BINARY", "")
+
+
+def data(name):
+    return os.path.join(DATA, name)
+
+
+def test_version():
+    assert skinmesh.__version__.count(".") == 2
+
+
+def test_mesh_arrays_equal_the_command():
+    m = skinmesh.mesh(data("pept.pdb"))
+    assert m.vertices.dtype == np.float64 and m.vertices.shape[1] == 3
+    assert m.triangles.dtype == np.int64 and m.triangles.shape[1] == 3
+    assert m.triangles.max() < len(m.vertices)
+    assert set(m.attributes) == {"atom", "patch", "normals"}
+    assert m.attributes["atom"].shape == (len(m.vertices),)
+    assert all(m.report["guarantees"].values())
+    assert m.report["quality"]["min_angle_deg"] >= 30.0
+    if BINARY:
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "pept.ply")
+            report = os.path.join(d, "pept.json")
+            subprocess.run([BINARY, "--quiet", "mesh", data("pept.pdb"), "-o", out, "--report", report], check=True)
+            with open(report) as f:
+                command = json.load(f)
+        assert command["quality"]["vertices"] == len(m.vertices)
+        assert command["quality"]["triangles"] == len(m.triangles)
+        assert command["quality"]["euler_characteristic"] == m.report["quality"]["euler_characteristic"]
+
+
+def test_vertices_are_handed_over_without_a_copy():
+    m = skinmesh.mesh(data("pept.pdb"))
+    assert not m.vertices.flags["OWNDATA"]  # the library's memory, kept alive by the array
+    assert m.vertices.flags["C_CONTIGUOUS"]
+
+
+def test_mesh_from_centres_and_radii_equals_the_file():
+    from_file = skinmesh.mesh(data("pept.pdb"))
+    lines = [l for l in open(data("pept.pdb")) if l.startswith(("ATOM", "HETATM"))]
+    assert len(lines) > 0
+    one = skinmesh.mesh((np.zeros((1, 3)), np.array([1.5])))
+    # one atom of radius 1.5 A: the skin is the sphere of radius 1.5 A (weights r^2/s)
+    r = np.linalg.norm(one.vertices, axis=1)
+    assert np.allclose(r, 1.5, atol=1e-9)
+    assert one.report["quality"]["components"] == 1
+    assert from_file.report["quality"]["components"] >= 1
+
+
+def test_grade_of_any_mesh():
+    m = skinmesh.mesh(data("pept.pdb"))
+    g = skinmesh.grade(m.vertices, m.triangles)
+    assert g["triangles"] == len(m.triangles)
+    assert g["closed"] and g["manifold"] and g["consistently_oriented"]
+    with pytest.raises(ValueError):
+        skinmesh.grade(m.vertices, m.triangles + len(m.vertices))
+
+
+def test_bad_input_raises_with_file_and_line():
+    with tempfile.TemporaryDirectory() as d:
+        bad = os.path.join(d, "bad.xyzr")
+        with open(bad, "w") as f:
+            f.write("1 2 3 1.5\n1 2 x 1.5\n")
+        with pytest.raises(skinmesh.InputError) as e:
+            skinmesh.mesh(bad)
+        assert e.value.file == bad
+        assert e.value.line == 2
+    with pytest.raises(TypeError):
+        skinmesh.mesh(data("pept.pdb"), no_such_option=1)
+
+
+def test_moving_balls_keep_ids_and_every_frame_holds():
+    lines = [l for l in open(data("pept.pdb")) if l.startswith(("ATOM", "HETATM"))]
+    centres = np.array([[float(l[30:38]), float(l[38:46]), float(l[46:54])] for l in lines])
+    radii = np.full(len(centres), 1.7)
+    moving = skinmesh.MovingBalls(radii)
+    first = moving.advance_to(centres, 0.0)
+    for k in range(1, 4):
+        f = moving.advance_to(centres + np.array([0.3 * k, 0, 0]), float(k))
+        assert f.report["guarantees"]["min_angle_at_least_bound"] and f.report["guarantees"]["vertices_on_skin"]
+        assert f.report["guarantees"]["topology"]
+        assert f.report["topology_certified"]
+        assert np.array_equal(f.ids, first.ids)  # a rigid translation keeps every vertex
+        assert np.allclose(f.vertices, first.vertices + np.array([0.3 * k, 0, 0]), atol=1e-9)
+
+
+def test_morph_frames_are_valid_and_ids_continue():
+    morph = skinmesh.Morph(data("2k39_3models.pdb"), data("2k39_3models.pdb"), model=1)
+    assert morph.matched  # one molecule: its atoms travel
+    ids = set(morph.frame.ids.tolist())
+    f = morph.advance_to(0.5)
+    assert f.report["guarantees"]["min_angle_at_least_bound"] and f.report["guarantees"]["vertices_on_skin"]
+    assert f.report["guarantees"]["topology"]
+    assert len(ids & set(f.ids.tolist())) > 0.5 * len(f.ids)
+    blend = skinmesh.Morph(data("pept.pdb"), data("3al1.pdb"))
+    assert not blend.matched
+    g = blend.advance_to(0.5)
+    assert g.report["guarantees"]["vertices_on_skin"] and g.report["guarantees"]["topology"]
+    assert "target_atom" in g.attributes
+
+
+def test_meshio_writes_what_the_module_returns():
+    import meshio
+    m = skinmesh.mesh(data("pept.pdb"))
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "pept.vtu")
+        meshio.write(path, meshio.Mesh(m.vertices, [("triangle", m.triangles)]))
+        back = meshio.read(path)
+        assert len(back.points) == len(m.vertices)
+
+
+def test_an_mdanalysis_trajectory_becomes_a_continuous_morph():
+    import MDAnalysis as mda
+    from MDAnalysis.analysis import align
+
+    with tempfile.TemporaryDirectory() as d:
+        # The ensemble's three models written as a DCD trajectory by MDAnalysis, read back through it.
+        models = mda.Universe(data("2k39_3models.pdb"))
+        heavy = models.select_atoms("not element H")
+        dcd = os.path.join(d, "2k39.dcd")
+        with mda.Writer(dcd, heavy.n_atoms) as w:
+            for _ in models.trajectory:
+                w.write(heavy)
+        pdb = os.path.join(d, "first.pdb")
+        models.trajectory[0]
+        heavy.write(pdb)
+        u = mda.Universe(pdb, dcd)
+        assert len(u.trajectory) == 3
+        align.AlignTraj(u, u, select="all", in_memory=True).run()
+        radii = np.array([{"C": 1.7, "N": 1.55, "O": 1.52, "S": 1.8}.get(e, 1.8) for e in u.atoms.elements])
+        moving = skinmesh.MovingBalls(radii)
+        before = None
+        for ts in u.trajectory:
+            f = moving.advance_to(u.atoms.positions.astype(np.float64), float(ts.frame))
+            assert f.report["guarantees"]["min_angle_at_least_bound"] and f.report["guarantees"]["vertices_on_skin"]
+            assert f.report["guarantees"]["topology"]
+            if before is not None:
+                assert len(before & set(f.ids.tolist())) > 0  # the same mesh carried on
+            before = set(f.ids.tolist())
