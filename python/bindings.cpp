@@ -7,6 +7,7 @@
 #include "quality_report.hpp"
 
 #include "skinmesh/core/error.hpp"
+#include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_topology.hpp"
@@ -18,6 +19,7 @@
 #include "skinmesh/morph/moving_balls.hpp"
 #include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
+#include "skinmesh/volume/volume_mesh.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -304,6 +306,97 @@ py::object grade(const py::array_t<double, py::array::c_style | py::array::force
   return json_to_python(app::to_json(q));
 }
 
+// The mixed complex of a molecule or ball set: its counts and topology.
+py::dict complex_counts(const py::object& source, const py::kwargs& kwargs) {
+  Options o{kwargs.cast<py::dict>(), {}};
+  const double shrink = o.get<double>("shrink", 0.5);
+  const BallSource in = balls_from(source, o, shrink);
+  o.finish();
+  std::array<long, 4> counts{};
+  SkinTopology topology;
+  size_t hidden = 0;
+  {
+    py::gil_scoped_release release;
+    const SkinComplex complex = build_skin_complex(in.balls, {shrink});
+    counts = complex.cell_counts();
+    hidden = complex.hidden_balls().size();
+    topology = skin_topology(in.balls);
+  }
+  py::dict out;
+  out["balls"] = in.balls.size();
+  out["hidden_balls"] = hidden;
+  out["cells"] = py::make_tuple(counts[0], counts[1], counts[2], counts[3]);
+  out["components"] = topology.components;
+  out["voids"] = topology.voids;
+  out["euler"] = topology.euler;
+  return out;
+}
+
+// The balls of B(t) of a morph (docs/math.md section 4): the live pairs', or all m x n.
+py::tuple interpolate(const py::object& source, const py::object& target, double t, const py::kwargs& kwargs) {
+  Options o{kwargs.cast<py::dict>(), {}};
+  const double shrink = o.get<double>("shrink", 0.5);
+  const bool all = o.get<bool>("all_pairs", false);
+  Options for_target{o.given, o.used};
+  const BallSource a = balls_from(source, o, shrink), b = balls_from(target, for_target, shrink);
+  o.finish();
+  if (!(t >= 0 && t <= 1)) throw py::value_error("t must lie in [0, 1]");
+  std::vector<Ball> balls;
+  {
+    py::gil_scoped_release release;
+    balls = interpolated_balls(a.balls, b.balls, all ? all_pairs(a.balls.size(), b.balls.size()) : live_pairs(a.balls, b.balls), t);
+  }
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<double> weights;
+  for (const Ball& ball : balls) {
+    centres.push_back(ball.center);
+    weights.push_back(ball.weight);
+  }
+  return py::make_tuple(vertex_array(std::move(centres)), array_of<double>(weights));
+}
+
+struct VolumeResult {
+  py::array_t<double> points;
+  py::array_t<std::int64_t> tetrahedra, faces;
+  py::array_t<std::int64_t> tetrahedron_region, face_marker;
+};
+
+// A tetrahedral mesh bounded by the skin mesh (TetGen; `skinmesh volume`).
+VolumeResult volume(const py::object& source, const py::kwargs& kwargs) {
+  Options o{kwargs.cast<py::dict>(), {}};
+  const double shrink = o.get<double>("shrink", 0.5);
+  const BallSource in = balls_from(source, o, shrink);
+  MeshingOptions m = meshing_options(o, 30.0);
+  VolumeOptions v;
+  const std::string domain = o.get<std::string>("domain", "interior");
+  if (domain != "interior" && domain != "exterior" && domain != "both")
+    throw py::value_error("domain must be interior, exterior or both");
+  v.domain = domain == "interior" ? VolumeDomain::interior : domain == "exterior" ? VolumeDomain::exterior : VolumeDomain::both;
+  v.box_margin = o.get<double>("box_margin", v.box_margin);
+  v.max_volume = o.get<double>("max_volume", 0.0);
+  v.cavities = o.get<bool>("drop_cavities", false) ? Cavities::fill : Cavities::keep;
+  o.finish();
+  VolumeMeshResult made;
+  {
+    py::gil_scoped_release release;
+    const SkinMeshResult surface = mesh_skin(build_skin_complex(in.balls, {shrink}), m);
+    if (surface.status != MeshingStatus::ok) throw std::runtime_error(surface.message);
+    made = tetrahedralize(surface.mesh, v);
+  }
+  if (made.status != VolumeStatus::ok) throw std::runtime_error(made.message);
+  VolumeResult out;
+  out.points = vertex_array(std::move(made.mesh.points));
+  py::array_t<std::int64_t> tets({static_cast<py::ssize_t>(made.mesh.tets.size()), py::ssize_t{4}});
+  auto view = tets.mutable_unchecked<2>();
+  for (size_t k = 0; k < made.mesh.tets.size(); ++k)
+    for (size_t j = 0; j < 4; ++j) view(static_cast<py::ssize_t>(k), static_cast<py::ssize_t>(j)) = made.mesh.tets[k][j];
+  out.tetrahedra = tets;
+  out.faces = triangle_array(made.mesh.faces);
+  out.tetrahedron_region = array_of<int, std::int64_t>(made.mesh.tet_region);
+  out.face_marker = array_of<int, std::int64_t>(made.mesh.face_marker);
+  return out;
+}
+
 // Moving balls fed centres call by call (morph/moving_balls.hpp): the first
 // call meshes, every later one carries the mesh on.
 class PyMovingBalls {
@@ -487,6 +580,18 @@ PYBIND11_MODULE(_skinmesh, m) {
       .def_readonly("report", &Frame::report);
   m.def("mesh", &mesh, py::arg("source"),
         "Quality mesh of the skin of a molecule file or of (centres, radii); options as on the command line.");
+  py::class_<VolumeResult>(m, "VolumeMesh")
+      .def_readonly("points", &VolumeResult::points)
+      .def_readonly("tetrahedra", &VolumeResult::tetrahedra)
+      .def_readonly("faces", &VolumeResult::faces)
+      .def_readonly("tetrahedron_region", &VolumeResult::tetrahedron_region)
+      .def_readonly("face_marker", &VolumeResult::face_marker);
+  m.def("complex", &complex_counts, py::arg("source"),
+        "The mixed complex's cell counts (vertex, edge, triangle, tetrahedron cells) and the skin's topology.");
+  m.def("interpolate", &interpolate, py::arg("source"), py::arg("target"), py::arg("t"),
+        "The balls of B(t) as (centres, weights); all_pairs=True for the m x n set.");
+  m.def("volume", &volume, py::arg("source"),
+        "Tetrahedra bounded by the skin mesh (TetGen): points, tetrahedra, faces, regions and markers.");
   m.def("grade", &grade, py::arg("vertices"), py::arg("triangles"), "The quality report of any triangle mesh.");
   py::class_<PyMovingBalls>(m, "MovingBalls")
       .def(py::init<const py::array_t<double, py::array::c_style | py::array::forcecast>&, const py::kwargs&>(),

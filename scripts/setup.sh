@@ -20,6 +20,7 @@ packages=(
   robin-map-dev                                     # flat hash map (the morph's mesh edits)
   pybind11-dev python3-dev python3-numpy            # the Python module (docs/python.md)
   python3-pytest python3-meshio python3-mdanalysis  # its tests: pytest, meshio, MD trajectories
+  snakemake                                         # many structures: workflows/Snakefile (docs/batch.md)
 )
 
 source "$here/scripts/install-packages.sh"

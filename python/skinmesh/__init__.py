@@ -11,9 +11,14 @@ from ._skinmesh import (  # noqa: F401
     Mesh,
     Morph,
     MovingBalls,
+    VolumeMesh,
     __version__,
+    complex,
     grade,
+    interpolate,
     mesh,
+    volume,
 )
 
-__all__ = ["Error", "Frame", "InputError", "Mesh", "Morph", "MovingBalls", "__version__", "grade", "mesh"]
+__all__ = ["Error", "Frame", "InputError", "Mesh", "Morph", "MovingBalls", "VolumeMesh", "__version__", "complex",
+           "grade", "interpolate", "mesh", "volume"]

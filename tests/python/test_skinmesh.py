@@ -154,3 +154,35 @@ def test_an_mdanalysis_trajectory_becomes_a_continuous_morph():
             if before is not None:
                 assert len(before & set(f.ids.tolist())) > 0  # the same mesh carried on
             before = set(f.ids.tolist())
+
+
+def test_complex_counts_and_topology_equal_the_mesh():
+    c = skinmesh.complex(data("pept.pdb"))
+    m = skinmesh.mesh(data("pept.pdb"))
+    assert c["balls"] == m.report["atoms"]
+    assert len(c["cells"]) == 4 and c["cells"][0] == c["balls"] - c["hidden_balls"]
+    assert c["components"] == m.report["quality"]["components"]
+    assert c["euler"] == m.report["quality"]["euler_characteristic"]
+
+
+def test_interpolate_equals_the_command():
+    centres, weights = skinmesh.interpolate(data("pept.pdb"), data("3al1.pdb"), 0.5)
+    assert centres.shape == (len(weights), 3)
+    if BINARY:
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "mid.wpts")
+            subprocess.run([BINARY, "--quiet", "interpolate", data("pept.pdb"), data("3al1.pdb"), "--t", "0.5", "-o", out],
+                           check=True)
+            rows = np.array([[float(x) for x in l.split()] for l in open(out) if l.strip() and not l.startswith("#")])
+        assert len(rows) == len(weights)
+        assert np.allclose(rows[:, :3], centres, atol=1e-12) and np.allclose(rows[:, 3], weights, atol=1e-12)
+
+
+def test_volume_mesh_of_a_peptide():
+    v = skinmesh.volume(data("pept.pdb"))
+    assert v.points.shape[1] == 3 and v.tetrahedra.shape[1] == 4
+    assert v.tetrahedra.max() < len(v.points)
+    p = v.points[v.tetrahedra]
+    signed = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0]) / 6
+    assert (signed > 0).all()  # positively oriented
+    assert set(np.unique(v.tetrahedron_region)) <= {1, 3}
