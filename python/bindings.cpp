@@ -375,7 +375,13 @@ VolumeResult volume(const py::object& source, const py::kwargs& kwargs) {
   v.box_margin = o.get<double>("box_margin", v.box_margin);
   v.max_volume = o.get<double>("max_volume", 0.0);
   v.cavities = o.get<bool>("drop_cavities", false) ? Cavities::fill : Cavities::keep;
+  const py::object progress = o.get<py::object>("progress", py::none());
   o.finish();
+  if (!progress.is_none())
+    m.progress = [progress](const MeshingProgress& p) {
+      py::gil_scoped_acquire gil;
+      progress(std::string(p.stage), p.vertices, p.expected_vertices);
+    };
   VolumeMeshResult made;
   {
     py::gil_scoped_release release;
