@@ -32,6 +32,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -50,6 +51,7 @@ struct MorphCommandOptions {
   std::vector<double> times;  // instead of --frames
   std::string align = "auto";
   std::string pairs = "auto";
+  std::string spacing = "uniform";
   double max_step = MovingOptions{}.max_step;  // Angstrom, --pairs matched
   std::vector<std::string> formats{"ply", "vtp"};
   MorphOptions morph;
@@ -77,6 +79,10 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
                  "matched (each atom one ball that travels, radius kept), all (the m x n blend of every source "
                  "and target ball), or auto (matched when both sides are one molecule, as --align auto decides)")
       ->check(CLI::IsMember({"auto", "matched", "all"}))->capture_default_str();
+  cmd.add_option("--spacing", o.spacing,
+                 "with --frames: uniform (equal steps of t) or change (equal steps of the largest ball move: "
+                 "centre plus skin radius)")
+      ->check(CLI::IsMember({"uniform", "change"}))->capture_default_str();
   cmd.add_option("--max-step", o.max_step, "--pairs matched: largest move of an atom in one internal step, A")
       ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
   cmd.add_option("--min-angle", o.morph.frames.min_angle, "smallest angle of every triangle of every frame, degrees")
@@ -414,6 +420,7 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
                  {"target_only_atoms", motion.target_only},
                  {"alignment", alignment_json(sides.alignment, sides.unmoved)},
                  {"frame_times", times},
+                 {"spacing", o.spacing},
                  {"min_angle", options.frames.min_angle},
                  {"first_frame_min_angle", options.first.min_angle},
                  {"max_step", run.options.max_step}};
@@ -442,13 +449,58 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
   return ExitCode::ok;
 }
 
+// --spacing change: the change from t to t' is the largest move of a ball
+// between the two ball sets, its centre's way plus the change of its skin
+// radius sqrt(s w) (a bound on how far the union of the shrunk balls
+// moves); summed over a fine grid of t, the frames are put at equal shares
+// of the sum. The m x n blend, whose weights fall by t(1-t)|a_i - b_j|^2,
+// then takes small steps near the end, where balls grow fast.
+std::vector<double> change_spaced(size_t frames, const std::function<std::vector<Ball>(double)>& balls_at, double shrink) {
+  const size_t grid = std::min<size_t>(40000, std::max<size_t>(8192, 64 * (frames - 1)));
+  const auto radius = [shrink](const Ball& b) { return std::sqrt(shrink * std::max(b.weight, 0.0)); };
+  std::vector<double> sum(grid + 1, 0.0);
+  std::vector<Ball> before = balls_at(0.0);
+  for (size_t g = 1; g <= grid; ++g) {
+    const std::vector<Ball> now = balls_at(static_cast<double>(g) / static_cast<double>(grid));
+    double largest = 0;
+    for (size_t i = 0; i < now.size(); ++i)
+      largest = std::max(largest, (now[i].center - before[i].center).norm() + std::abs(radius(now[i]) - radius(before[i])));
+    sum[g] = sum[g - 1] + largest;
+    before = now;
+  }
+  std::vector<double> t{0.0};
+  size_t g = 0;
+  for (size_t k = 1; k + 1 < frames; ++k) {
+    const double share = sum[grid] * static_cast<double>(k) / static_cast<double>(frames - 1);
+    while (g < grid && sum[g + 1] < share) ++g;
+    const double within = sum[g + 1] > sum[g] ? (share - sum[g]) / (sum[g + 1] - sum[g]) : 0.0;
+    t.push_back((static_cast<double>(g) + within) / static_cast<double>(grid));
+  }
+  t.push_back(1.0);
+  for (size_t k = 1; k < t.size(); ++k)  // strictly increasing, as advance_to needs
+    if (!(t[k] > t[k - 1])) t[k] = std::nextafter(t[k - 1], 2.0);
+  return t;
+}
+
 ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
-  const std::vector<double> times = frame_times(o);
+  std::vector<double> times = frame_times(o);
+  if (o.spacing == "change" && !o.times.empty()) contract_error("--spacing change goes with --frames, not --t");
   const MorphOptions options = morph_options(o);
   const Sides sides = read_sides(o);
   const Pairing pairing = choose_pairing(o, sides);
+  if (o.spacing == "change") {
+    if (pairing.matched) {
+      const MatchedMotion motion = match_motion(sides.source, sides.source_balls, sides.target, sides.target_balls);
+      times = change_spaced(times.size(), [&](double t) { return motion.balls_at(t); }, o.molecule.shrink);
+    } else {
+      const std::vector<BallPair> live = live_pairs(sides.source_balls, sides.target_balls);
+      times = change_spaced(
+          times.size(), [&](double t) { return interpolated_balls(sides.source_balls, sides.target_balls, live, t); },
+          o.molecule.shrink);
+    }
+  }
   if (progress) {
     print_alignment(sides);
     std::cerr << "skinmesh: pairs " << (pairing.matched ? "matched" : "all") << ": " << pairing.why << "\n";
@@ -482,6 +534,7 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   if (progress) std::cerr << "\n";
   json report = morph_json(o, sides, morph, times, options);
   report["pairs"] = "all";
+  report["spacing"] = o.spacing;
   report["pairs_because"] = pairing.why;
   report["source_balls_file"] = stage_side(outputs, dir, "source", sides.source, sides.source_balls);
   report["target_balls_file"] = stage_side(outputs, dir, "target", sides.target, sides.target_balls);

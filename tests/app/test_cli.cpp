@@ -2,6 +2,7 @@
 #include "cgal_reference.hpp"
 #include "test_support.hpp"
 
+#include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/mesh_io/mesh_read.hpp"
 #include "skinmesh/mesh_io/mesh_write.hpp"
@@ -11,7 +12,9 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
+#include <numeric>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -534,6 +537,58 @@ TEST_CASE("skinmesh morph --pairs matched: a translated molecule travels rigidly
   REQUIRE(all.code == 0);
   std::ifstream all_json(dir + "-all/morph.json");
   CHECK(nlohmann::json::parse(all_json)["pairs"] == "all");
+  std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
+TEST_CASE("skinmesh morph --spacing change: frames at equal shares of the largest ball move", "[cli][morph]") {
+  char pattern[] = "/tmp/skinmesh-spacing-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = std::string(pattern) + "/out";
+  const std::string pept = skinmesh::test::data_file("pept.pdb"), al1 = skinmesh::test::data_file("3al1.pdb");
+  const Run r = run("--quiet morph " + pept + " " + al1 + " --frames 6 --spacing change --no-self-intersections -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  std::ifstream morph_json(dir + "/morph.json");
+  const auto m = nlohmann::json::parse(morph_json);
+  CHECK(m["spacing"] == "change");
+  const std::vector<double> t = m["frame_times"].get<std::vector<double>>();
+  REQUIRE(t.size() == 6);
+  CHECK(t.front() == 0.0);
+  CHECK(t.back() == 1.0);
+  // The change between frames, recomputed here from B(t) on a grid of its
+  // own: each step's share within 20% of the mean, where uniform steps of t
+  // differ by more than a factor of 2 on this pair.
+  std::vector<skinmesh::Ball> a = skinmesh::balls_from_molecule(skinmesh::read_molecule(pept), 0.5);
+  std::vector<skinmesh::Ball> b = skinmesh::balls_from_molecule(skinmesh::read_molecule(al1), 0.5);
+  const std::string moved_target = dir + "/target.xyzr";  // the target after alignment, as the morph used it
+  b = skinmesh::balls_from_molecule(skinmesh::read_molecule(moved_target), 0.5);
+  const auto live = skinmesh::live_pairs(a, b);
+  const auto change = [&](double from, double to) {
+    double sum = 0;
+    const int grid = 1600;
+    std::vector<skinmesh::Ball> before = skinmesh::interpolated_balls(a, b, live, from);
+    for (int g = 1; g <= grid; ++g) {
+      const auto now = skinmesh::interpolated_balls(a, b, live, from + (to - from) * g / grid);
+      double largest = 0;
+      for (size_t i = 0; i < now.size(); ++i)
+        largest = std::max(largest, (now[i].center - before[i].center).norm() +
+                                        std::abs(std::sqrt(0.5 * std::max(now[i].weight, 0.0)) -
+                                                 std::sqrt(0.5 * std::max(before[i].weight, 0.0))));
+      sum += largest;
+      before = now;
+    }
+    return sum;
+  };
+  std::vector<double> steps, uniform;
+  for (size_t k = 1; k < t.size(); ++k) {
+    steps.push_back(change(t[k - 1], t[k]));
+    uniform.push_back(change((k - 1) / 5.0, k / 5.0));
+  }
+  const double mean = std::accumulate(steps.begin(), steps.end(), 0.0) / steps.size();
+  for (double c : steps) CHECK(std::abs(c - mean) <= 0.1 * mean);
+  CHECK(*std::max_element(uniform.begin(), uniform.end()) > 2 * *std::min_element(uniform.begin(), uniform.end()));
+  const Run with_t = run("--quiet morph " + pept + " " + al1 + " --t 0.5 --spacing change -o " + dir + "-t");
+  CHECK(with_t.code == 2);
   std::system(("rm -rf " + std::string(pattern)).c_str());
 }
 
