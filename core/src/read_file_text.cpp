@@ -64,6 +64,9 @@ std::string read_file_text(const std::string& path, long long max_bytes) {
     all << in.rdbuf();
     text = all.str();
   }
+  // A UTF-8 byte-order mark (editors on Windows write one) is no part of
+  // the first record: left in, it hid the first ATOM line from every reader.
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     input_error(path, 0, "file is empty");
   return text;

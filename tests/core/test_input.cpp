@@ -425,3 +425,23 @@ TEST_CASE("bounded input: devices refused, size and inflated size limited", "[in
   mb.max_bytes = 1 << 20;
   expect_input_error(bomb.path(), 0, "inflates to more than 1048576 bytes", mb);
 }
+
+TEST_CASE("a UTF-8 byte-order mark before the first record is read past, not the first atom dropped", "[input][bad]") {
+  std::ifstream in(test::data_file("pept.pdb"), std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  const size_t plain = read_molecule(test::data_file("pept.pdb")).atoms.size();
+  for (const char* name : {"pept-bom.pdb", "pept-bom.pqr"}) {
+    const std::string body = std::string(name).find(".pqr") != std::string::npos
+                                 ? "ATOM      1  N   ALA A   1      11.104   6.134  -6.504  0.0000 1.5500\n"
+                                   "ATOM      2  CA  ALA A   1      11.639   6.071  -5.147  0.0000 1.7000\n"
+                                 : text.str();
+    const test::TempFile with_mark(name, "\xEF\xBB\xBF" + body);
+    const test::TempFile without(std::string("plain-") + name, body);
+    INFO(name);
+    const Molecule m = read_molecule(with_mark.path());
+    CHECK(m.atoms.size() == read_molecule(without.path()).atoms.size());
+    CHECK(m.atoms.front().position == read_molecule(without.path()).atoms.front().position);
+  }
+  CHECK(read_molecule(test::TempFile("p.pdb", "\xEF\xBB\xBF" + text.str()).path()).atoms.size() == plain);
+}
