@@ -188,7 +188,9 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   const double seconds_grading = seconds_since(grade_start);
 
   const MeshingStats& s = result.stats;
-  json report = {{"molecule", o.molecule.path},
+  json report = {{"skinmesh_version", version_text()},
+                 {"command_line", global.command_line},
+                 {"molecule", o.molecule.path},
                  {"atoms", m.atoms.size()},
                  {"shrink", o.molecule.shrink},
                  {"weights", convention_name(o.molecule.convention())},

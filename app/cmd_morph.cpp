@@ -400,7 +400,9 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
               << json_text(result.failed_frame) << "\n";
     return ExitCode::not_met;
   }
-  json report = {{"source", o.source},
+  json report = {{"skinmesh_version", version_text()},
+                 {"command_line", global.command_line},
+                 {"source", o.source},
                  {"target", o.target},
                  {"source_model", o.source_model},
                  {"target_model", o.target_model},
@@ -533,6 +535,8 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   }
   if (progress) std::cerr << "\n";
   json report = morph_json(o, sides, morph, times, options);
+  report["skinmesh_version"] = version_text();
+  report["command_line"] = global.command_line;
   report["pairs"] = "all";
   report["spacing"] = o.spacing;
   report["pairs_because"] = pairing.why;

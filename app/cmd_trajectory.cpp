@@ -167,7 +167,9 @@ ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global)
   }
   std::vector<size_t> keyframes;
   for (size_t i = 0; i < keys.size(); ++i) keyframes.push_back(i * per);
-  json report = {{"source", o.molecule.path},
+  json report = {{"skinmesh_version", version_text()},
+                 {"command_line", global.command_line},
+                 {"source", o.molecule.path},
                  {"models", models},
                  {"models_in_file", all.size()},
                  {"keyframes", keyframes},

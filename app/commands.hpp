@@ -14,7 +14,13 @@ namespace skinmesh::app {
 struct GlobalOptions {
   bool json = false;   // machine-readable output on stdout
   bool quiet = false;  // no progress or warnings on the terminal
+  std::string command_line;  // as typed, for the reports
 };
+
+// "0.1.0" (the CMake project's version), with " (commit abc1234)" when built
+// from a git checkout.
+const char* version_text();
+
 
 // CLI11's range checks let NaN through (every comparison with it is false)
 // and accept infinities: every numeric option is checked by this first.

@@ -7,6 +7,15 @@
 #include "skinmesh/core/error.hpp"
 
 #include <iostream>
+#include <string>
+
+const char* skinmesh::app::version_text() {
+#ifdef SKINMESH_COMMIT
+  return SKINMESH_VERSION " (commit " SKINMESH_COMMIT ")";
+#else
+  return SKINMESH_VERSION;
+#endif
+}
 
 int main(int argc, char** argv) {
   skinmesh::app::watch_interrupts();  // first: before any thread starts
@@ -15,6 +24,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.fallthrough();  // --json and --quiet may follow the subcommand
   skinmesh::app::GlobalOptions global;
+  for (int i = 0; i < argc; ++i) global.command_line += (i ? " " : "") + std::string(argv[i]);
+  app.set_version_flag("--version", std::string("skinmesh ") + skinmesh::app::version_text());
   app.add_flag("--json", global.json, "machine-readable JSON on stdout");
   app.add_flag("--quiet,-q", global.quiet, "no progress or warnings on the terminal");
   int exit_code = code(skinmesh::app::ExitCode::ok);

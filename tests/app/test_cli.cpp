@@ -540,6 +540,22 @@ TEST_CASE("skinmesh morph --pairs matched: a translated molecule travels rigidly
   std::system(("rm -rf " + std::string(pattern)).c_str());
 }
 
+TEST_CASE("skinmesh --version, and reports that say which version wrote them and how it was called", "[cli]") {
+  const Run v = run("--version");
+  CHECK(v.code == 0);
+  CHECK(v.output.rfind("skinmesh 0.", 0) == 0);
+  char pattern[] = "/tmp/skinmesh-version-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string report = std::string(pattern) + "/r.json";
+  const Run r = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + pattern + "/p.ply --report " + report);
+  REQUIRE(r.code == 0);
+  std::ifstream in(report);
+  const auto j = nlohmann::json::parse(in);
+  CHECK(j["skinmesh_version"].get<std::string>().rfind(v.output.substr(9, 5), 0) == 0);
+  CHECK(j["command_line"].get<std::string>().find("mesh " + skinmesh::test::data_file("pept.pdb")) != std::string::npos);
+  std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
 TEST_CASE("skinmesh morph --spacing change: frames at equal shares of the largest ball move", "[cli][morph]") {
   char pattern[] = "/tmp/skinmesh-spacing-XXXXXX";
   REQUIRE(mkdtemp(pattern) != nullptr);
