@@ -72,7 +72,8 @@ Motion models_2k39() {
   const Molecule first = read_molecule(data("2k39_3models.pdb"), read);
   read.model = 3;
   Molecule third = read_molecule(data("2k39_3models.pdb"), read);
-  third = moved(std::move(third), align(first, third, AlignmentMethod::kabsch).motion);
+  const RigidMotion fit = align(first, third, AlignmentMethod::kabsch).motion;  // before third is moved from
+  third = moved(std::move(third), fit);
   const std::vector<Ball> a = balls_from_molecule(first, kShrink), b = balls_from_molecule(third, kShrink);
   return {"2k39 model 1 -> 3", a.size(), [=](double s) {
             if (s == 1) return b;

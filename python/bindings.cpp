@@ -479,7 +479,8 @@ class PyMorph {
                                                            {"centroid", AlignmentMethod::centroid},
                                                            {"kabsch", AlignmentMethod::kabsch}};
       if (!methods.count(how)) throw py::value_error("align must be auto, none, centroid or kabsch");
-      *b.molecule = moved(std::move(*b.molecule), align(*a.molecule, *b.molecule, methods.at(how)).motion);
+      const RigidMotion fit = align(*a.molecule, *b.molecule, methods.at(how)).motion;  // before it is moved from
+      *b.molecule = moved(std::move(*b.molecule), fit);
       snap_unmoved(*a.molecule, *b.molecule);
       b.balls = balls_from_molecule(*b.molecule, shrink_, convention);
       a.balls = balls_from_molecule(*a.molecule, shrink_, convention);

@@ -215,7 +215,8 @@ TEST_CASE("morph 1ubi -> 1hpv at t = 0.99: a nearly flat overlay cell keeps its 
   // Aligned as the command aligns them (the cell depends on the rounding).
   const Molecule ubiquitin = read_molecule(test::data_file("1ubi.pdb"), {});
   Molecule protease = read_molecule(test::data_file("1hpv.pdb"), {});
-  protease = moved(std::move(protease), align(ubiquitin, protease, AlignmentMethod::automatic).motion);
+  const RigidMotion fit = align(ubiquitin, protease, AlignmentMethod::automatic).motion;  // before protease is moved from
+  protease = moved(std::move(protease), fit);
   const std::vector<Ball> source = balls_from_molecule(ubiquitin, 0.5), target = balls_from_molecule(protease, 0.5);
   const double t = 0.99;
   const Morph morph = prepare_morph(source, target, t);

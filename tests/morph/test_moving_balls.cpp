@@ -241,7 +241,8 @@ TEST_CASE("moving balls: ubiquitin's NMR models 1 -> 2 -> 3 as one motion, ids k
   for (int model = 2; model <= 3; ++model) {
     read.model = model;
     Molecule m = read_molecule(test::data_file("2k39_3models.pdb"), read);
-    m = moved(std::move(m), align(first, m, AlignmentMethod::kabsch).motion);
+    const RigidMotion fit = align(first, m, AlignmentMethod::kabsch).motion;  // before m is moved from
+    m = moved(std::move(m), fit);
     const std::vector<Ball> keyframe = balls_from_molecule(m, 0.5);
     REQUIRE(keyframe.size() == before.size());
     for (int k = 1; k <= 5; ++k) {
