@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -91,29 +92,53 @@ struct MovingCheck {
   bool holds = false;
 };
 
-MovingCheck check_moving_frame(const MovingBalls& moving, double min_angle, bool self_intersections) {
-  const SurfaceMesh& mesh = moving.frame().mesh;
+// A frame as made, copied out of the engine so that it can be checked and
+// written while the engine makes the next one.
+struct MadeFrame {
+  size_t index = 0;
+  MorphFrame frame;
+  std::vector<Ball> balls;
+  std::vector<int> owner, patch;  // per vertex: its ball, its patch type
+  double shrink = 0.5;
+};
+
+MadeFrame snapshot(const MovingBalls& moving, size_t k) {
+  MadeFrame m;
+  m.index = k;
+  m.frame = moving.frame();
+  m.balls = moving.balls();
+  m.owner = moving.vertex_balls();
+  for (int c : m.frame.mesh.cells) m.patch.push_back(moving.complex().cell(c).dim);
+  m.shrink = moving.complex().shrink();
+  return m;
+}
+
+MovingCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self_intersections) {
+  const SurfaceMesh& mesh = made.frame.mesh;
   MovingCheck c;
   GradeOptions grade;
   grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
   c.quality = grade_mesh(mesh, grade);
-  c.skin = skin_topology(moving.balls());
-  const SkinOracle oracle(moving.balls(), moving.complex().shrink());
+  c.skin = skin_topology(made.balls);
+  const SkinOracle oracle(made.balls, made.shrink);
   std::vector<double> off(mesh.vertices.size());
   std::vector<char> certified(mesh.vertices.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, off.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       const OracleResult e = oracle.evaluate(mesh.vertices[v]);
       certified[v] = e.certified;
-      if (e.certified) {
-        off[v] = e.distance();
-      } else {  // measured on the frame's own complex, and counted
-        const SkinEval s = moving.complex().evaluate(mesh.vertices[v], mesh.cells[v]);
-        off[v] = s.gradient.norm() > 0 ? std::abs(s.value) / s.gradient.norm() : INFINITY;
-      }
+      off[v] = e.distance();
     }
   });
   c.uncertified = std::count(certified.begin(), certified.end(), 0);
+  if (c.uncertified > 0) {  // measured on the complex of the frame's balls built from scratch, and counted
+    const SkinComplex own = build_skin_complex(made.balls, {made.shrink});
+    for (size_t v = 0; v < off.size(); ++v)
+      if (!certified[v]) {
+        const SkinEval e = own.evaluate(mesh.vertices[v]);
+        off[v] = e.gradient.norm() > 0 ? std::abs(e.value) / e.gradient.norm() : INFINITY;
+      }
+  }
   c.max_error = off.empty() ? 0.0 : *std::max_element(off.begin(), off.end());
   c.share_below_bound = share_below(mesh, min_angle);
   const MeshQuality& q = c.quality;
@@ -164,58 +189,74 @@ json moving_frame_json(const FrameStats& s, const MovingCheck& c, const std::str
 // The frame's mesh in every format asked for, with per vertex its patch
 // type, id, owning ball, and that ball's source and target atoms ("atom"
 // is the ball's index: the line of the frame's .wpts); and its balls.
-void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, size_t k, const MovingBalls& moving,
-                        const MovingFrames& run) {
-  const MorphFrame& f = moving.frame();
-  const std::vector<int> owner = moving.vertex_balls();
+void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, const MadeFrame& made, const MovingFrames& run) {
+  const MorphFrame& f = made.frame;
   VertexAttributes a;
   std::vector<int> ids, source_atoms, target_atoms;
   for (size_t v = 0; v < f.mesh.vertices.size(); ++v) {
-    a.patch.push_back(moving.complex().cell(f.mesh.cells[v]).dim);
-    a.atom.push_back(owner[v]);
+    const size_t ball = static_cast<size_t>(made.owner[v]);
+    a.patch.push_back(made.patch[v]);
+    a.atom.push_back(made.owner[v]);
     ids.push_back(static_cast<int>(f.ids[v]));
-    source_atoms.push_back(run.ball_atoms[static_cast<size_t>(owner[v])][0]);
-    target_atoms.push_back(run.ball_atoms[static_cast<size_t>(owner[v])][1]);
+    source_atoms.push_back(run.ball_atoms[ball][0]);
+    target_atoms.push_back(run.ball_atoms[ball][1]);
   }
   a.more = {{"id", ids}, {"source_atom", source_atoms}, {"target_atom", target_atoms}};
+  const size_t k = made.index;
   for (const std::string& format : run.formats) {
     const MeshFormat mf = mesh_format_from_path(frame_name(k, format));
     outputs.add(dir.file(frame_name(k, format)), [&](std::ostream& out) { write_mesh(out, f.mesh, mf, &a); });
   }
   outputs.add(dir.file(frame_name(k, "wpts")), [&](std::ostream& out) {
-    write_wpts(out, moving.balls(), "the balls of " + frame_name(k, run.formats.front()) + " (t = " +
-                                        exact_number_text(f.stats.t) + ")");
+    write_wpts(out, made.balls, "the balls of " + frame_name(k, run.formats.front()) + " (t = " +
+                                    exact_number_text(f.stats.t) + ")");
   });
 }
 
 }  // namespace
 
+// Frame k is checked and written while frame k+1 is made: the engine's
+// repairs are mostly serial and the check (grading, the oracle at every
+// vertex, the exact self-intersection test) runs beside them.
 MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs, const OutputDirectory& dir,
                                      std::ostream& lines) {
   const auto start = Clock::now();
   MovingFramesResult result;
   MovingBalls moving(run.balls_of(0), run.options, run.times.front());
-  for (size_t k = 0; k < run.times.size(); ++k) {
-    const MorphFrame& f = k == 0 ? moving.frame() : moving.advance_to(run.balls_of(k), run.times[k]);
-    const MovingCheck check = check_moving_frame(moving, run.options.frames.min_angle, run.self_intersections);
-    const json line = moving_frame_json(f.stats, check, frame_name(k, run.formats.front()));
+  MadeFrame pending;
+  MovingCheck check;
+  tbb::task_group checking;
+  // Waits for the pending frame's check, then writes it; false when it failed.
+  const auto finish = [&]() {
+    checking.wait();
+    const FrameStats& st = pending.frame.stats;
+    const json line = moving_frame_json(st, check, frame_name(pending.index, run.formats.front()));
     if (!check.holds) {
       result.failed_frame = line;
-      result.failed_index = k;
-      return result;
+      result.failed_index = pending.index;
+      return false;
     }
-    stage_moving_frame(outputs, dir, k, moving, run);
+    stage_moving_frame(outputs, dir, pending, run);
     lines << json_text(line, JsonLayout::one_line) << "\n";
-    result.repairs += f.stats.repairs;
-    if (k > 0) {
-      result.repaired += f.stats.repaired;
-      result.remeshed += f.stats.remeshed;
-      result.rebuilt += f.stats.full_rebuild;
-      result.min_ids_kept = std::min(result.min_ids_kept, f.stats.ids_kept);
-      result.max_kept_move = std::max(result.max_kept_move, f.stats.max_kept_move);
+    result.repairs += st.repairs;
+    if (pending.index > 0) {
+      result.repaired += st.repaired;
+      result.remeshed += st.remeshed;
+      result.rebuilt += st.full_rebuild;
+      result.min_ids_kept = std::min(result.min_ids_kept, st.ids_kept);
+      result.max_kept_move = std::max(result.max_kept_move, st.max_kept_move);
     }
-    if (run.progress) print_progress(k + 1, run.times.size(), f.stats, result.repairs, seconds_since(start));
+    if (run.progress) print_progress(pending.index + 1, run.times.size(), st, result.repairs, seconds_since(start));
+    return true;
+  };
+  for (size_t k = 0; k < run.times.size(); ++k) {
+    if (k > 0) moving.advance_to(run.balls_of(k), run.times[k]);
+    MadeFrame made = snapshot(moving, k);
+    if (k > 0 && !finish()) return result;
+    pending = std::move(made);
+    checking.run([&] { check = check_moving_frame(pending, run.options.frames.min_angle, run.self_intersections); });
   }
+  if (!finish()) return result;
   if (run.progress) std::fprintf(stderr, "\n");
   result.holds = true;
   return result;
