@@ -322,6 +322,7 @@ std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const PatchMeshRe
 // new triangle fails.
 struct Attempt {
   bool ok = false;
+  std::string failed_because;
   SurfaceMesh merged;
   long repairs = 0;
   std::vector<int> faults;
@@ -341,10 +342,16 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   std::vector<int> index;
   const std::vector<SkinSample> samples = patch_samples(mesh, role, drop, roles, index);
   // Nearly the whole frame: no faults, so the caller remeshes it whole.
-  if (static_cast<double>(samples.size()) > options.max_sample_share * static_cast<double>(mesh.vertices.size()))
+  if (static_cast<double>(samples.size()) > options.max_sample_share * static_cast<double>(mesh.vertices.size())) {
+    a.failed_because = "the patch took nearly the whole frame (" + std::to_string(samples.size()) + " of " +
+                       std::to_string(mesh.vertices.size()) + " vertices)";
     return a;
+  }
   const PatchMeshResult patch = mesh_patch(complex, samples, roles, repair);
-  if (patch.status != MeshingStatus::ok) return a;  // no faults: growing would not help
+  if (patch.status != MeshingStatus::ok) {  // no faults: growing would not help
+    a.failed_because = std::string("the patch's refinement ended ") + meshing_status_name(patch.status);
+    return a;
+  }
   a.merged.vertices = mesh.vertices;
   a.merged.cells = mesh.cells;
   a.merged.normals = mesh.normals;
@@ -369,7 +376,10 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
     if (bad[f])
       for (int v : fresh[f])
         if (static_cast<size_t>(v) < mesh.vertices.size()) a.faults.push_back(v);
-  if (!a.faults.empty()) return a;
+  if (!a.faults.empty()) {
+    a.failed_because = std::to_string(a.faults.size()) + " seam or criteria faults left after growing the patch";
+    return a;
+  }
   a.merged.triangles.insert(a.merged.triangles.end(), fresh.begin(), fresh.end());
   a.repairs = patch.stats.inserted_size + patch.stats.inserted_shape + patch.stats.inserted_distance +
               patch.stats.inserted_topology;
@@ -447,13 +457,18 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given,
   for (int attempt = 0; attempt < options.attempts; ++attempt) {
     Attempt a = try_patch(complex, mesh, stars, region, given.vertices.size(), repair, accept, options);
     if (a.ok) {
-      if (!topology_as_expected(given, a.merged, options)) return out;
+      if (!topology_as_expected(given, a.merged, options)) {
+        out.failed_because = "the patched mesh's Euler characteristic or components are not what the topology "
+                             "changes say";
+        return out;
+      }
       out.patch_triangles = std::count(region.begin(), region.end(), 1);
       compact(a.merged, given.vertices.size(), out);
       out.repairs = a.repairs;
       out.ok = true;
       return out;
     }
+    out.failed_because = a.failed_because;
     if (a.faults.empty()) return out;
     std::vector<char> more(region.size(), 0);
     for (int v : a.faults) stars.each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });

@@ -12,6 +12,7 @@
 #include "skinmesh/mesher/skin_mesher.hpp"
 
 #include <array>
+#include <string>
 #include <vector>
 
 namespace skinmesh::detail {
@@ -22,6 +23,7 @@ struct LocalRepair {
   std::vector<long> origin;  // per vertex: its index in the mesh before, or -1 when inserted
   long repairs = 0;          // refinement insertions
   long patch_triangles = 0;  // triangles replaced
+  std::string failed_because;  // when !ok: which check gave up
 };
 
 // A place where the skin's topology changes between the frames (a critical

@@ -289,6 +289,31 @@ void topology_changes(const SkinComplex& from, const std::vector<int>& from_crit
   }
 }
 
+// Of the places topology_changes found, those where a size can have
+// crossed zero in the step: |R2| at most 4 r dz + dz^2, dz the largest ball
+// move of the step and r the largest ball radius (R2 = |z - z_i|^2 - w_i
+// moves by no more). A critical cell that came or went with a larger size
+// did so by a flip or a cancelling pair, which changes no topology. When
+// none is that small, all are kept.
+void keep_events(const SkinComplex& from, const SkinComplex& to, detail::LocalRepairOptions& local,
+                 std::vector<detail::VanishingSphere>& vanished) {
+  double dz = 0, r = 0;
+  for (size_t i = 0; i < to.balls().size(); ++i) {
+    dz = std::max(dz, ball_move(from.balls()[i], to.balls()[i]));
+    r = std::max(r, radius_of(to.balls()[i]));
+  }
+  const double bound = 4 * r * dz + dz * dz;
+  std::vector<detail::TopologyChange> changes;
+  std::vector<detail::VanishingSphere> spheres;
+  for (const auto& c : local.changes)
+    if (c.size * c.size <= bound) changes.push_back(c);
+  for (const auto& v : vanished)
+    if ((v.reach - 1) * (v.reach - 1) / 4 <= bound) spheres.push_back(v);
+  if (changes.empty() && spheres.empty()) return;
+  local.changes = std::move(changes);
+  vanished = std::move(spheres);
+}
+
 MeshingOptions with_size_margin(MeshingOptions o, double margin) {
   o.sizing.epsilon *= margin;
   o.edge_length *= margin;
@@ -519,7 +544,10 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
   detail::LocalRepairOptions local;
   local.crowded_below = options_.crowded_below;
   std::vector<detail::VanishingSphere> vanished;
-  topology_changes(complex_, critical_, next, critical, topology == topology_, local, vanished);
+  if (topology != topology_) {
+    topology_changes(complex_, critical_, next, critical, false, local, vanished);
+    keep_events(complex_, next, local, vanished);
+  }  // otherwise the critical cells that came or went are flips and cancelling pairs: no place to remesh
   local.euler_change = topology.euler - topology_.euler;
   if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, local.euler_change))
     for (const detail::VanishingSphere& v : vanished) {  // not a component of its own: the patch takes it
@@ -577,7 +605,7 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
       s.patch_triangles += patched.patch_triangles;
       s.repairs += patched.repairs;
     } else {
-      because = "the local patch failed (its seam, its criteria or its Euler characteristic)";
+      because = "the local patch failed: " + patched.failed_because;
     }
   }
   s.seconds_repair += seconds_since(stage);
