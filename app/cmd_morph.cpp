@@ -156,16 +156,6 @@ Sides read_sides(const MorphCommandOptions& o) {
   return s;
 }
 
-// What is measured of each frame before it is written.
-struct FrameCheck {
-  MeshQuality quality;
-  double max_error = 0;   // distance of the vertices to the skin of B(t), Angstrom (see check_frame)
-  long uncertified = 0;   // vertices the morph oracle could not certify
-  double share_below_bound = 0;  // of the triangles, those whose smallest angle is under the bound
-  SkinTopology skin;             // of B(t)'s balls, from their alpha complex: the frame must have it
-  bool holds = false;
-};
-
 // What a frame is measured against: the morph oracle and, where it cannot
 // certify, the complex of B(t)'s balls built from scratch.
 struct FrameReference {
@@ -220,46 +210,16 @@ FrameCheck check_frame(const SurfaceMesh& mesh, const FrameReference& reference,
   grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
   c.quality = grade_mesh(mesh, grade);
   c.max_error = largest_error(mesh, reference, t, c.uncertified);
-  c.share_below_bound = share_below(mesh, min_angle);
   c.skin = skin_topology(reference.balls_at(t));
-  const MeshQuality& q = c.quality;
-  c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
-            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
-            q.components == c.skin.components && q.cavities == c.skin.voids && q.euler == c.skin.euler;
+  judge_frame(c, mesh, min_angle, self_intersections);
   return c;
 }
 
-json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
-  const MeshQuality& q = c.quality;
-  return {{"t", s.t},
-          {"file", file},
-          {"vertices", s.vertices},
-          {"triangles", s.triangles},
-          {"min_angle", q.min_angle},
-          {"share_below_bound", c.share_below_bound},
-          {"moved", s.moved},
-          {"relocated", s.relocated},
-          {"inserted", s.inserted},
-          {"removed", s.removed},
-          {"repairs", s.repairs},
-          {"edits", {{"split", s.split}, {"flipped", s.flipped}, {"contracted", s.contracted}}},
-          {"bad_triangles_after_transport", s.bad_triangles},
-          {"repaired", s.repaired},
-          {"full_rebuild", s.full_rebuild},
-          {"events", s.events},
-          {"max_onsurf_error", c.max_error},
-          {"oracle_uncertified", c.uncertified},
-          {"components", q.components},
-          {"voids", q.cavities},
-          {"euler", q.euler},
-          {"skin_topology", {{"components", c.skin.components}, {"voids", c.skin.voids}, {"euler", c.skin.euler}}},
-          {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
-          {"seconds", s.seconds},
-          {"seconds_complex", s.seconds_complex},
-          {"seconds_transport", s.seconds_transport},
-          {"seconds_relax", s.seconds_relax},
-          {"seconds_judge", s.seconds_judge},
-          {"seconds_repair", s.seconds_repair}};
+// The m x n morph's frames.jsonl line: the common fields and its events.
+json blend_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
+  json j = frame_json(s, c, file);
+  j["events"] = s.events;
+  return j;
 }
 
 // The frame's mesh in every format asked for, with per-vertex patch, id and
@@ -519,7 +479,7 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
     const MorphFrame& f =
         k == 0 ? morph.frame() : morph.advance_to(times[k], k + 1 < times.size() ? times[k + 1] : -1);
     const FrameCheck check = check_frame(f.mesh, reference, times[k], options.frames.min_angle, !o.no_self_intersections);
-    json line = frame_json(f.stats, check, frame_name(k, o.formats.front()));
+    json line = blend_frame_json(f.stats, check, frame_name(k, o.formats.front()));
     if (!check.holds) {
       if (progress) std::cerr << "\n";
       std::cerr << "skinmesh: error: frame " << k << " (t = " << times[k] << ") fails a guarantee; nothing written\n"

@@ -74,6 +74,46 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees) {
   return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
 }
 
+void judge_frame(FrameCheck& c, const SurfaceMesh& mesh, double min_angle, bool self_intersections) {
+  c.share_below_bound = share_below(mesh, min_angle);
+  const MeshQuality& q = c.quality;
+  c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
+            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
+            q.components == c.skin.components && q.cavities == c.skin.voids && q.euler == c.skin.euler;
+}
+
+json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
+  const MeshQuality& q = c.quality;
+  return {{"t", s.t},
+          {"file", file},
+          {"vertices", s.vertices},
+          {"triangles", s.triangles},
+          {"min_angle", q.min_angle},
+          {"share_below_bound", c.share_below_bound},
+          {"moved", s.moved},
+          {"relocated", s.relocated},
+          {"inserted", s.inserted},
+          {"removed", s.removed},
+          {"repairs", s.repairs},
+          {"edits", {{"split", s.split}, {"flipped", s.flipped}, {"contracted", s.contracted}}},
+          {"bad_triangles_after_transport", s.bad_triangles},
+          {"repaired", s.repaired},
+          {"full_rebuild", s.full_rebuild},
+          {"max_onsurf_error", c.max_error},
+          {"oracle_uncertified", c.uncertified},
+          {"components", q.components},
+          {"voids", q.cavities},
+          {"euler", q.euler},
+          {"skin_topology", {{"components", c.skin.components}, {"voids", c.skin.voids}, {"euler", c.skin.euler}}},
+          {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
+          {"seconds", s.seconds},
+          {"seconds_complex", s.seconds_complex},
+          {"seconds_transport", s.seconds_transport},
+          {"seconds_relax", s.seconds_relax},
+          {"seconds_judge", s.seconds_judge},
+          {"seconds_repair", s.seconds_repair}};
+}
+
 void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed) {
   const double left = done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0.0;
   std::fprintf(stderr, "\rskinmesh: frame %zu/%zu  t = %.4f  %ld vertices  %ld repairs  %.0f s left   ", done, total,
@@ -82,15 +122,6 @@ void print_progress(size_t done, size_t total, const FrameStats& s, long repairs
 }
 
 namespace {
-
-struct MovingCheck {
-  MeshQuality quality;
-  SkinTopology skin;          // of the frame's balls, from their alpha complex
-  double max_error = 0;       // by the static oracle of the frame's balls, Angstrom
-  long uncertified = 0;       // vertices the oracle could not certify (measured on the frame's complex instead)
-  double share_below_bound = 0;
-  bool holds = false;
-};
 
 // A frame as made, copied out of the engine so that it can be checked and
 // written while the engine makes the next one.
@@ -113,9 +144,9 @@ MadeFrame snapshot(const MovingBalls& moving, size_t k) {
   return m;
 }
 
-MovingCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self_intersections) {
+FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self_intersections) {
   const SurfaceMesh& mesh = made.frame.mesh;
-  MovingCheck c;
+  FrameCheck c;
   GradeOptions grade;
   grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
   c.quality = grade_mesh(mesh, grade);
@@ -140,50 +171,19 @@ MovingCheck check_moving_frame(const MadeFrame& made, double min_angle, bool sel
       }
   }
   c.max_error = off.empty() ? 0.0 : *std::max_element(off.begin(), off.end());
-  c.share_below_bound = share_below(mesh, min_angle);
-  const MeshQuality& q = c.quality;
-  c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
-            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
-            q.components == c.skin.components && q.cavities == c.skin.voids && q.euler == c.skin.euler;
+  judge_frame(c, mesh, min_angle, self_intersections);
   return c;
 }
 
-json moving_frame_json(const FrameStats& s, const MovingCheck& c, const std::string& file) {
-  const MeshQuality& q = c.quality;
-  return {{"t", s.t},
-          {"file", file},
-          {"vertices", s.vertices},
-          {"triangles", s.triangles},
-          {"min_angle", q.min_angle},
-          {"share_below_bound", c.share_below_bound},
-          {"steps", s.steps},
-          {"moved", s.moved},
-          {"relocated", s.relocated},
-          {"reidentified", s.reidentified},
-          {"ids_kept", s.ids_kept},
-          {"max_kept_move", s.max_kept_move},
-          {"inserted", s.inserted},
-          {"removed", s.removed},
-          {"repairs", s.repairs},
-          {"edits", {{"split", s.split}, {"flipped", s.flipped}, {"contracted", s.contracted}}},
-          {"bad_triangles_after_transport", s.bad_triangles},
-          {"repaired", s.repaired},
-          {"remeshed", s.remeshed},
-          {"remeshed_because", s.remeshed ? json(s.remeshed_because) : json(nullptr)},
-          {"full_rebuild", s.full_rebuild},
-          {"max_onsurf_error", c.max_error},
-          {"oracle_uncertified", c.uncertified},
-          {"components", q.components},
-          {"voids", q.cavities},
-          {"euler", q.euler},
-          {"skin_topology", {{"components", c.skin.components}, {"voids", c.skin.voids}, {"euler", c.skin.euler}}},
-          {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
-          {"seconds", s.seconds},
-          {"seconds_complex", s.seconds_complex},
-          {"seconds_transport", s.seconds_transport},
-          {"seconds_relax", s.seconds_relax},
-          {"seconds_judge", s.seconds_judge},
-          {"seconds_repair", s.seconds_repair}};
+json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
+  json j = frame_json(s, c, file);
+  j["steps"] = s.steps;
+  j["reidentified"] = s.reidentified;
+  j["ids_kept"] = s.ids_kept;
+  j["max_kept_move"] = s.max_kept_move;
+  j["remeshed"] = s.remeshed;
+  j["remeshed_because"] = s.remeshed ? json(s.remeshed_because) : json(nullptr);
+  return j;
 }
 
 // The frame's mesh in every format asked for, with per vertex its patch
@@ -224,7 +224,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs
   MovingFramesResult result;
   MovingBalls moving(run.balls_of(0), run.options, run.times.front());
   MadeFrame pending;
-  MovingCheck check;
+  FrameCheck check;
   tbb::task_group checking;
   // Waits for the pending frame's check, then writes it; false when it failed.
   const auto finish = [&]() {

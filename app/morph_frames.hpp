@@ -7,9 +7,11 @@
 #include "output_file.hpp"
 
 #include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -47,6 +49,22 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees);
 // One line on the terminal, rewritten: frames done, vertices, repairs and
 // the time left at the pace so far.
 void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed);
+
+// What is measured of every frame before it is written, either kind of morph.
+struct FrameCheck {
+  MeshQuality quality;
+  SkinTopology skin;             // of the frame's balls, from their alpha complex: the frame must have it
+  double max_error = 0;          // distance of the vertices to the frame's skin by an oracle, Angstrom
+  long uncertified = 0;          // vertices the oracle could not certify (measured on a complex built from scratch)
+  double share_below_bound = 0;  // of the triangles, those whose smallest angle is under the bound
+  bool holds = false;
+};
+// Fills share_below_bound and holds from the rest: the angle bound, closed
+// oriented manifold enclosing positive volume, no self-intersections (when
+// checked), every vertex within 1e-8 A, and the skin's topology.
+void judge_frame(FrameCheck& c, const SurfaceMesh& mesh, double min_angle, bool self_intersections);
+// The frames.jsonl fields both kinds of morph write.
+nlohmann::json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file);
 
 // A run of moving balls to write: frame k holds balls_of(k), recorded at times[k].
 struct MovingFrames {
