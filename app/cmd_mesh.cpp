@@ -86,28 +86,6 @@ void add_mesh_options(CLI::App& cmd, MeshCommandOptions& o) {
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
 }
 
-json options_json(const MeshingOptions& m) {
-  return {{"min_angle_deg", m.min_angle},
-          {"epsilon", m.edge_length > 0 ? json(nullptr) : json(m.sizing.epsilon)},
-          {"edge_length", m.edge_length > 0 ? json(m.edge_length) : json(nullptr)},
-          {"min_size", m.sizing.min_size},
-          {"max_size", m.sizing.max_size},
-          {"tolerance", m.tolerance},
-          {"contract_below", m.contract_below},
-          {"max_triangles", m.max_triangles}};
-}
-
-json refinement_json(const MeshingStats& s) {
-  return {{"seeds", s.seeds},
-          {"inserted_for_size", s.inserted_size},
-          {"inserted_for_distance", s.inserted_distance},
-          {"inserted_for_angle", s.inserted_shape},
-          {"inserted_for_topology", s.inserted_topology},
-          {"passes", s.passes},
-          {"contracted_edges", s.contracted},
-          {"contraction_attempts", s.contraction_attempts}};
-}
-
 // Every file the command will write.
 std::vector<std::string> output_paths(const MeshCommandOptions& o, MeshFormat format) {
   std::vector<std::string> paths;

@@ -166,4 +166,26 @@ void print_tet_quality(std::ostream& out, const TetQuality& q) {
       << " away from the surface); " << q.inverted << " inverted\n";
 }
 
+nlohmann::json options_json(const MeshingOptions& m) {
+  return {{"min_angle_deg", m.min_angle},
+          {"epsilon", m.edge_length > 0 ? nlohmann::json(nullptr) : nlohmann::json(m.sizing.epsilon)},
+          {"edge_length", m.edge_length > 0 ? nlohmann::json(m.edge_length) : nlohmann::json(nullptr)},
+          {"min_size", m.sizing.min_size},
+          {"max_size", m.sizing.max_size},
+          {"tolerance", m.tolerance},
+          {"contract_below", m.contract_below},
+          {"max_triangles", m.max_triangles}};
+}
+
+nlohmann::json refinement_json(const MeshingStats& s) {
+  return {{"seeds", s.seeds},
+          {"inserted_for_size", s.inserted_size},
+          {"inserted_for_distance", s.inserted_distance},
+          {"inserted_for_angle", s.inserted_shape},
+          {"inserted_for_topology", s.inserted_topology},
+          {"passes", s.passes},
+          {"contracted_edges", s.contracted},
+          {"contraction_attempts", s.contraction_attempts}};
+}
+
 }  // namespace skinmesh::app

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "skinmesh/core/tet_mesh.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 #include "skinmesh/quality/on_surface_error.hpp"
@@ -29,6 +30,10 @@ nlohmann::json to_json(const MeshQuality& q);
 nlohmann::json to_json(const SurfaceError& e);
 // Each guarantee true or false (no_self_intersections null when not checked).
 nlohmann::json guarantees_json(const GuaranteeReport& g);
+
+// The mesher's options and its refinement counts as `skinmesh mesh --report` writes them.
+nlohmann::json options_json(const MeshingOptions& m);
+nlohmann::json refinement_json(const MeshingStats& s);
 
 void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q);
 

@@ -4,6 +4,8 @@
 // attributes a dict of arrays; reports dicts (the JSON the command writes).
 // Long calls release the GIL; errors are Python exceptions, InputError
 // keeping the file and the line.
+#include "morph_frames.hpp"
+#include "output_file.hpp"
 #include "quality_report.hpp"
 
 #include "skinmesh/core/error.hpp"
@@ -17,6 +19,7 @@
 #include "skinmesh/morph/matched_motion.hpp"
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 #include "skinmesh/volume/volume_mesh.hpp"
@@ -26,6 +29,8 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -241,6 +246,10 @@ Frame frame_of(const MorphFrame& f, const std::vector<int>& atom, const std::vec
 
 // ---- calls -----------------------------------------------------------------
 
+std::string json_source(const py::object& source) {
+  return py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
+}
+
 MeshResult mesh(const py::object& source, const py::kwargs& kwargs) {
   Options o{kwargs.cast<py::dict>(), {}};
   const double shrink = o.get<double>("shrink", 0.5);
@@ -279,8 +288,14 @@ MeshResult mesh(const py::object& source, const py::kwargs& kwargs) {
   if (made.status == MeshingStatus::empty_skin) throw py::value_error(made.message);
   if (made.status != MeshingStatus::ok) throw std::runtime_error(made.message);
   if (!g.all_hold()) throw std::runtime_error("the mesh fails a guarantee: " + app::guarantees_json(g).dump());
-  nlohmann::json report = {{"atoms", in.balls.size()},
+  nlohmann::json report = {{"skinmesh_version", SKINMESH_VERSION},
+                           {"molecule", in.molecule ? nlohmann::json(json_source(source)) : nlohmann::json(nullptr)},
+                           {"atoms", in.balls.size()},
                            {"shrink", shrink},
+                           {"weights", convention_name(convention_of(o.get<std::string>("weights", "grow")))},
+                           {"options", app::options_json(m)},
+                           {"refinement", app::refinement_json(made.stats)},
+                           {"estimated_triangles", std::llround(made.estimated_triangles)},
                            {"quality", app::to_json(g.quality)},
                            {"on_surface_error", app::to_json(g.surface_error)},
                            {"guarantees", app::guarantees_json(g)},
@@ -552,6 +567,53 @@ class PyMorph {
   std::vector<Ball> source_, target_;
 };
 
+// Frames (Morph's or MovingBalls') written as a morph directory, as
+// `skinmesh morph` writes one (docs/morph.md): frame_NNNN.{ply,vtp} with
+// per-vertex id, atom, patch (and target_atom), frames.pvd, frames.jsonl
+// of the frames' reports. All files or none; the directory is made when
+// missing.
+void write_frames(const std::string& directory, const py::iterable& frames, const std::vector<std::string>& formats) {
+  if (formats.empty()) throw py::value_error("formats: at least one of ply, vtp, off, obj, stl");
+  for (const std::string& f : formats)
+    if (f != "ply" && f != "vtp" && f != "off" && f != "obj" && f != "stl")
+      throw py::value_error("formats: '" + f + "' is none of ply, vtp, off, obj, stl");
+  const py::object dumps = py::module_::import("json").attr("dumps");
+  app::OutputDirectory dir(directory);
+  app::OutputSet outputs;
+  std::ostringstream lines;
+  std::vector<double> times;
+  size_t k = 0;
+  for (const py::handle item : frames) {
+    const Frame& f = item.cast<const Frame&>();
+    SurfaceMesh mesh = mesh_from(f.vertices, f.triangles);
+    mesh.normals = points_from(f.attributes["normals"].cast<py::array_t<double, py::array::c_style | py::array::forcecast>>(), "normals");
+    VertexAttributes a;
+    const auto ints = [&](const char* name) {
+      const auto arr = f.attributes[name].cast<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>>();
+      return std::vector<int>(arr.data(), arr.data() + arr.size());
+    };
+    a.patch = ints("patch");
+    a.atom = ints("atom");
+    std::vector<int> ids(f.ids.data(), f.ids.data() + f.ids.size());
+    a.more = {{"id", ids}};
+    if (f.attributes.contains("target_atom")) a.more.push_back({"target_atom", ints("target_atom")});
+    for (const std::string& format : formats) {
+      const std::string name = app::frame_name(k, format);
+      outputs.add(dir.file(name), [&](std::ostream& out) { write_mesh(out, mesh, mesh_format_from_path(name), &a); });
+    }
+    const py::dict report = f.report.cast<py::dict>();
+    times.push_back(report.contains("t") ? report["t"].cast<double>() : static_cast<double>(k));
+    lines << dumps(report).cast<std::string>() << "\n";
+    ++k;
+  }
+  if (k == 0) throw py::value_error("no frames to write");
+  if (std::find(formats.begin(), formats.end(), "vtp") != formats.end())
+    outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { app::write_pvd(out, times); });
+  outputs.add(dir.file("frames.jsonl"), [&](std::ostream& out) { out << lines.str(); });
+  outputs.commit();
+  dir.keep();
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_skinmesh, m) {
@@ -599,6 +661,9 @@ PYBIND11_MODULE(_skinmesh, m) {
         "The balls of B(t) as (centres, weights); all_pairs=True for the m x n set.");
   m.def("volume", &volume, py::arg("source"),
         "Tetrahedra bounded by the skin mesh (TetGen): points, tetrahedra, faces, regions and markers.");
+  m.def("write_frames", &write_frames, py::arg("directory"), py::arg("frames"),
+        py::arg("formats") = std::vector<std::string>{"ply", "vtp"},
+        "Frames written as a morph directory: frame_NNNN.ply/.vtp with per-vertex id, atom, patch, frames.pvd, frames.jsonl.");
   m.def("grade", &grade, py::arg("vertices"), py::arg("triangles"), "The quality report of any triangle mesh.");
   py::class_<PyMovingBalls>(m, "MovingBalls")
       .def(py::init<const py::array_t<double, py::array::c_style | py::array::forcecast>&, const py::kwargs&>(),

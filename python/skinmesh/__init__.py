@@ -18,6 +18,7 @@ from ._skinmesh import (  # noqa: F401
     interpolate,
     mesh,
     volume,
+    write_frames,
 )
 
 
@@ -38,4 +39,4 @@ Morph.frames = _frames
 MovingBalls.frames = _moving_frames
 
 __all__ = ["Error", "Frame", "InputError", "Mesh", "Morph", "MovingBalls", "VolumeMesh", "__version__", "complex",
-           "grade", "interpolate", "mesh", "volume"]
+           "grade", "interpolate", "mesh", "volume", "write_frames"]

@@ -45,6 +45,8 @@ def test_mesh_arrays_equal_the_command():
         with open(report) as f:
             command = json.load(f)
         ply = meshio.read(out)
+    assert set(command) - {"command_line", "output", "format"} == set(m.report)  # the report --report writes
+    assert command["quality"] == m.report["quality"]
     assert command["quality"]["vertices"] == len(m.vertices)
     assert command["quality"]["euler_characteristic"] == m.report["quality"]["euler_characteristic"]
     assert np.array_equal(ply.points, m.vertices)
@@ -152,13 +154,30 @@ def test_an_mdanalysis_trajectory_becomes_a_continuous_morph():
         radii = np.array([{"C": 1.7, "N": 1.55, "O": 1.52, "S": 1.8}.get(e, 1.8) for e in u.atoms.elements])
         moving = skinmesh.MovingBalls(radii)
         before = None
+        frames = []
         for ts in u.trajectory:
             f = moving.advance_to(u.atoms.positions.astype(np.float64), float(ts.frame))
+            frames.append(f)
             assert f.report["guarantees"]["min_angle_at_least_bound"] and f.report["guarantees"]["vertices_on_skin"]
             assert f.report["guarantees"]["topology"]
             if before is not None:
                 assert len(before & set(f.ids.tolist())) > 0  # the same mesh carried on
             before = set(f.ids.tolist())
+        # ... and a morph directory as `skinmesh morph` writes one.
+        out = os.path.join(d, "morph")
+        skinmesh.write_frames(out, frames)
+        assert sorted(os.listdir(out)) == ["frame_0000.ply", "frame_0000.vtp", "frame_0001.ply", "frame_0001.vtp",
+                                           "frame_0002.ply", "frame_0002.vtp", "frames.jsonl", "frames.pvd"]
+        import meshio
+
+        ply = meshio.read(os.path.join(out, "frame_0002.ply"))
+        assert np.array_equal(ply.points, frames[2].vertices)
+        assert np.array_equal(np.asarray(ply.point_data["id"]), frames[2].ids)
+        lines = [json.loads(l) for l in open(os.path.join(out, "frames.jsonl"))]
+        assert [l["t"] for l in lines] == [0.0, 1.0, 2.0]
+        with pytest.raises(ValueError):
+            skinmesh.write_frames(os.path.join(d, "bad"), frames, formats=["ply", "xyz"])
+        assert not os.path.exists(os.path.join(d, "bad"))
 
 
 def test_complex_counts_and_topology_equal_the_mesh():
