@@ -175,6 +175,16 @@ MeshingOptions meshing_options(Options& o, double default_angle) {
   return m;
 }
 
+// A Python callable as the mesher's progress callback, called with the
+// stage, the vertices so far and the expected count (the GIL taken back).
+std::function<void(const MeshingProgress&)> progress_from(const py::object& progress) {
+  if (progress.is_none()) return {};
+  return [progress](const MeshingProgress& p) {
+    py::gil_scoped_acquire gil;
+    progress(std::string(p.stage), p.vertices, p.expected_vertices);
+  };
+}
+
 // ---- results ---------------------------------------------------------------
 
 struct MeshResult {
@@ -431,6 +441,7 @@ class PyMovingBalls {
     options_.frames.min_angle = std::min(options_.first.min_angle, 20.0);
     options_.first.min_angle = 30.0;
     options_.max_step = o.get<double>("max_step", options_.max_step);
+    options_.first.progress = progress_from(o.get<py::object>("progress", py::none()));  // the first frame's mesh
     check_ = o.get<bool>("check", true);
     o.finish();
     if (radii.ndim() != 1) throw py::value_error("radii must be an (n,) array");
@@ -482,6 +493,7 @@ class PyMorph {
     m.frames.min_angle = std::min(m.first.min_angle, 20.0);
     m.first.min_angle = 30.0;
     min_angle_ = m.frames.min_angle;
+    m.first.progress = progress_from(o.get<py::object>("progress", py::none()));  // the first frame's mesh
     check_ = o.get<bool>("check", true);
     const WeightConvention convention = convention_of(o.get<std::string>("weights", "grow"));
     Options target_options{o.given, o.used};

@@ -97,8 +97,10 @@ def test_moving_balls_keep_ids_and_every_frame_holds():
     lines = [l for l in open(data("pept.pdb")) if l.startswith(("ATOM", "HETATM"))]
     centres = np.array([[float(l[30:38]), float(l[38:46]), float(l[46:54])] for l in lines])
     radii = np.full(len(centres), 1.7)
-    moving = skinmesh.MovingBalls(radii)
+    stages = []
+    moving = skinmesh.MovingBalls(radii, progress=lambda stage, vertices, expected: stages.append(stage))
     first = moving.advance_to(centres, 0.0)
+    assert "refining" in stages or "seeding" in stages  # the first frame's mesh reported its progress
     for k in range(1, 4):
         f = moving.advance_to(centres + np.array([0.3 * k, 0, 0]), float(k))
         assert f.report["guarantees"]["min_angle_at_least_bound"] and f.report["guarantees"]["vertices_on_skin"]
