@@ -524,6 +524,29 @@ void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, 
   s.topology_certified = true;
 }
 
+// Per triangle of `moved`, whether it fails the frame criteria, after the
+// corners of those that failed were relaxed along the skin once.
+std::vector<char> MovingBalls::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved) {
+  FrameStats& s = frame_.stats;
+  auto stage = Clock::now();
+  std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+  const long bad = std::count(failing.begin(), failing.end(), 1);
+  s.bad_triangles += bad;
+  s.seconds_judge += seconds_since(stage);
+  if (bad == 0 || options_.relaxation.passes == 0) return failing;
+  stage = Clock::now();
+  std::vector<char> corners(moved.vertices.size(), 0);
+  for (size_t f = 0; f < failing.size(); ++f)
+    if (failing[f])
+      for (int v : moved.triangles[f]) corners[static_cast<size_t>(v)] = 1;
+  relax_tangentially(next, moved, options_.relaxation, &corners);
+  s.seconds_relax += seconds_since(stage);
+  stage = Clock::now();
+  failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+  s.seconds_judge += seconds_since(stage);
+  return failing;
+}
+
 // Judging, relaxation, edits and a local patch (moving_balls.hpp). Returns
 // "" when they made a certified frame, else why the step must be remeshed
 // whole; `moved` and `lost` are then the mesh to remesh from and its lost
@@ -558,25 +581,9 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
     }
   const long lost_count = std::count(lost.begin(), lost.end(), 1);
   if (lost_count > 0) return std::to_string(lost_count) + " vertices could not be put on the new skin";
-  auto stage = Clock::now();
-  std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+  std::vector<char> failing = judge_and_relax(next, moved);
   long left = std::count(failing.begin(), failing.end(), 1);
-  s.bad_triangles += left;
-  s.seconds_judge += seconds_since(stage);
-  if (left > 0 && options_.relaxation.passes > 0) {
-    stage = Clock::now();
-    std::vector<char> corners(moved.vertices.size(), 0);
-    for (size_t f = 0; f < failing.size(); ++f)
-      if (failing[f])
-        for (int v : moved.triangles[f]) corners[static_cast<size_t>(v)] = 1;
-    relax_tangentially(next, moved, options_.relaxation, &corners);
-    s.seconds_relax += seconds_since(stage);
-    stage = Clock::now();
-    failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
-    left = std::count(failing.begin(), failing.end(), 1);
-    s.seconds_judge += seconds_since(stage);
-  }
-  stage = Clock::now();
+  const auto stage = Clock::now();
   if (left > 0 && options_.edits) {
     detail::Surgery edited =
         detail::mend_by_edits(next, std::move(moved), failing, options_.frames, {}, &frame_.ids, &refused_thinning_);

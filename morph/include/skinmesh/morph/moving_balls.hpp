@@ -96,6 +96,7 @@ class MovingBalls {
   void step(std::vector<Ball> balls);
   void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
               SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
+  std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved);
   std::string mend_locally(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
                            SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
