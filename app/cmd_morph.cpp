@@ -272,10 +272,8 @@ std::string stage_side(OutputSet& outputs, const OutputDirectory& dir, const std
   return name;
 }
 
-json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& morph, const std::vector<double>& t,
-                const MorphOptions& options) {
-  json events = json::array();
-  for (const TopologyEvent& e : morph.events()) events.push_back({{"t", e.t}, {"cell", e.cell}, {"dim", e.dim}, {"euler_change", e.euler_change}});
+// The two sides as morph.json names them, either kind of morph.
+json sides_json(const MorphCommandOptions& o, const Sides& sides) {
   return {{"source", o.source},
           {"target", o.target},
           {"source_model", o.source_model},
@@ -283,14 +281,22 @@ json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& m
           {"source_atoms", sides.source_balls.size()},
           {"target_atoms", sides.target_balls.size()},
           {"shrink", o.molecule.shrink},
-          {"weights", convention_name(o.molecule.convention())},
-          {"ball_sets", "B(t) = {(1-t) a_i + t b_j}, weight (1-t) w_i + t w_j - t(1-t)|z_i - z_j|^2 "
+          {"weights", convention_name(o.molecule.convention())}};
+}
+
+json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& morph, const std::vector<double>& t,
+                const MorphOptions& options) {
+  json events = json::array();
+  for (const TopologyEvent& e : morph.events()) events.push_back({{"t", e.t}, {"cell", e.cell}, {"dim", e.dim}, {"euler_change", e.euler_change}});
+  json j = sides_json(o, sides);
+  j.update({{"ball_sets", "B(t) = {(1-t) a_i + t b_j}, weight (1-t) w_i + t w_j - t(1-t)|z_i - z_j|^2 "
                         "(docs/math.md section 4); live pairs " + std::to_string(morph.pairs().size())},
           {"alignment", alignment_json(sides.alignment, sides.unmoved)},
           {"frame_times", t},
           {"topology_events", events},
           {"min_angle", options.frames.min_angle},
-          {"first_frame_min_angle", options.first.min_angle}};
+          {"first_frame_min_angle", options.first.min_angle}});
+  return j;
 }
 
 // Which balls the morph blends, and why (docs/morph.md, "Two kinds of morph").
@@ -360,16 +366,9 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
               << json_text(result.failed_frame) << "\n";
     return ExitCode::not_met;
   }
-  json report = {{"skinmesh_version", version_text()},
+  json report = sides_json(o, sides);
+  report.update({{"skinmesh_version", version_text()},
                  {"command_line", global.command_line},
-                 {"source", o.source},
-                 {"target", o.target},
-                 {"source_model", o.source_model},
-                 {"target_model", o.target_model},
-                 {"source_atoms", sides.source_balls.size()},
-                 {"target_atoms", sides.target_balls.size()},
-                 {"shrink", o.molecule.shrink},
-                 {"weights", convention_name(o.molecule.convention())},
                  {"pairs", "matched"},
                  {"pairs_because", pairing.why},
                  {"ball_sets",
@@ -385,7 +384,7 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
                  {"spacing", o.spacing},
                  {"min_angle", options.frames.min_angle},
                  {"first_frame_min_angle", options.first.min_angle},
-                 {"max_step", run.options.max_step}};
+                 {"max_step", run.options.max_step}});
   report["source_balls_file"] = stage_side(outputs, dir, "source", sides.source, sides.source_balls);
   report["target_balls_file"] = stage_side(outputs, dir, "target", sides.target, sides.target_balls);
   const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();

@@ -268,11 +268,7 @@ MeshResult mesh(const py::object& source, const py::kwargs& kwargs) {
   const bool self_intersections = !o.get<bool>("no_self_intersections", false);
   const py::object progress = o.get<py::object>("progress", py::none());
   o.finish();
-  if (!progress.is_none())
-    m.progress = [progress](const MeshingProgress& p) {
-      py::gil_scoped_acquire gil;
-      progress(std::string(p.stage), p.vertices, p.expected_vertices);
-    };
+  m.progress = progress_from(progress);
   SkinMeshResult made;
   GuaranteeReport g;
   std::vector<int> atom, patch;
@@ -402,11 +398,7 @@ VolumeResult volume(const py::object& source, const py::kwargs& kwargs) {
   v.cavities = o.get<bool>("drop_cavities", false) ? Cavities::fill : Cavities::keep;
   const py::object progress = o.get<py::object>("progress", py::none());
   o.finish();
-  if (!progress.is_none())
-    m.progress = [progress](const MeshingProgress& p) {
-      py::gil_scoped_acquire gil;
-      progress(std::string(p.stage), p.vertices, p.expected_vertices);
-    };
+  m.progress = progress_from(progress);
   VolumeMeshResult made;
   {
     py::gil_scoped_release release;

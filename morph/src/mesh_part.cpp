@@ -59,4 +59,22 @@ long mark_crowded(const SkinComplex& complex, const SurfaceMesh& mesh, const Mes
   return marked;
 }
 
+SkinMeshResult remesh_keeping_ids(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
+                                  const MeshingOptions& criteria, std::vector<long>& ids, long& next_id) {
+  std::vector<SkinSample> samples;
+  std::vector<long> sample_ids;
+  samples.reserve(mesh.vertices.size());
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (drop[v]) continue;
+    samples.push_back({mesh.vertices[v], mesh.cells[v]});
+    sample_ids.push_back(ids[v]);
+  }
+  SkinMeshResult made = remesh_skin(complex, samples, criteria);
+  if (made.status != MeshingStatus::ok) return made;
+  ids.resize(made.mesh.vertices.size());
+  for (size_t v = 0; v < ids.size(); ++v)
+    ids[v] = made.origins[v] >= 0 ? sample_ids[static_cast<size_t>(made.origins[v])] : next_id++;
+  return made;
+}
+
 }  // namespace skinmesh::detail

@@ -24,4 +24,10 @@ SurfaceMesh used_part(const SurfaceMesh& mesh, const std::vector<char>& keep_tri
 long mark_crowded(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria, double below,
                   std::vector<char>& drop);
 
+// The frame remeshed from its vertices not marked in `drop` (remesh_skin),
+// those kept carrying their `ids`, new ones taking next_id, next_id + 1, ...
+// `ids` becomes the result's (unchanged when the mesher cannot: status).
+SkinMeshResult remesh_keeping_ids(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
+                                  const MeshingOptions& criteria, std::vector<long>& ids, long& next_id);
+
 }  // namespace skinmesh::detail

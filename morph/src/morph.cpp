@@ -180,23 +180,10 @@ long Morph::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vect
 // Remeshes the frame from the transported vertices not dropped; false when
 // the mesher cannot (then the caller rebuilds from scratch).
 bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
-  std::vector<SkinSample> samples;
-  std::vector<long> sample_ids;
-  samples.reserve(moved.vertices.size());
-  for (size_t v = 0; v < moved.vertices.size(); ++v) {
-    if (drop[v]) continue;
-    samples.push_back({moved.vertices[v], moved.cells[v]});
-    sample_ids.push_back(frame_.ids[v]);
-  }
-  SkinMeshResult made = remesh_skin(next, samples, options_.repair_criteria());
+  std::vector<long> ids = frame_.ids;
+  SkinMeshResult made = detail::remesh_keeping_ids(next, moved, drop, options_.repair_criteria(), ids, next_id_);
   if (made.status != MeshingStatus::ok) return false;
-  std::vector<long> ids(made.mesh.vertices.size());
-  long kept = 0;
-  for (size_t v = 0; v < ids.size(); ++v) {
-    const long origin = made.origins[v];
-    ids[v] = origin >= 0 ? sample_ids[static_cast<size_t>(origin)] : next_id_++;
-    kept += origin >= 0;
-  }
+  const long kept = std::count_if(made.origins.begin(), made.origins.end(), [](long o) { return o >= 0; });
   const MeshingStats& m = made.stats;
   frame_.stats.repaired = true;
   frame_.stats.remeshed = true;

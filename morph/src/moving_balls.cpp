@@ -654,18 +654,9 @@ bool MovingBalls::drop_vanished(const std::vector<detail::VanishingSphere>& vani
 // false when the mesher cannot.
 bool MovingBalls::remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop,
                          const MeshingOptions& criteria) {
-  std::vector<SkinSample> samples;
-  std::vector<long> sample_ids;
-  for (size_t v = 0; v < moved.vertices.size(); ++v) {
-    if (drop[v]) continue;
-    samples.push_back({moved.vertices[v], moved.cells[v]});
-    sample_ids.push_back(frame_.ids[v]);
-  }
-  SkinMeshResult made = remesh_skin(next, samples, criteria);
+  std::vector<long> ids = frame_.ids;
+  SkinMeshResult made = detail::remesh_keeping_ids(next, moved, drop, criteria, ids, next_id_);
   if (made.status != MeshingStatus::ok) return false;
-  std::vector<long> ids(made.mesh.vertices.size());
-  for (size_t v = 0; v < ids.size(); ++v)
-    ids[v] = made.origins[v] >= 0 ? sample_ids[static_cast<size_t>(made.origins[v])] : next_id_++;
   frame_.mesh = std::move(made.mesh);
   frame_.ids = std::move(ids);
   return true;
