@@ -118,9 +118,12 @@ Eigen::Matrix3d cell_rotation(const MixedCell& cell, const std::vector<Ball>& ol
 
 enum class VertexFate : char { moved, relocated, lost };
 
-struct MovedVertex {
-  VertexFate fate = VertexFate::moved;
-  bool jumped = false;  // moved farther than continuity allows: a new id
+// Where a vertex was before a step, and how far it may move in the step
+// and keep its id: the largest move of its cell's balls plus `continuity`
+// times its longest mesh edge (Angstrom).
+struct Continuity {
+  Eigen::Vector3d from;
+  double bound = 0;
 };
 
 // Per vertex, its longest mesh edge (Angstrom).
@@ -137,14 +140,29 @@ std::vector<double> longest_edges(const SurfaceMesh& mesh) {
   return longest;
 }
 
+std::vector<Continuity> continuity_bounds(const SkinComplex& from, const SkinComplex& to, const SurfaceMesh& mesh,
+                                         double continuity) {
+  const std::vector<double> longest = longest_edges(mesh);
+  std::vector<Continuity> out(mesh.vertices.size());
+  for (size_t v = 0; v < out.size(); ++v) {
+    const MixedCell& cell = from.cell(mesh.cells[v]);
+    double balls_moved = 0;
+    for (int i = 0; i <= cell.dim; ++i) {
+      const size_t b = static_cast<size_t>(cell.balls[static_cast<size_t>(i)]);
+      balls_moved = std::max(balls_moved, ball_move(from.balls()[b], to.balls()[b]));
+    }
+    out[v] = {mesh.vertices[v], balls_moved + continuity * longest[v]};
+  }
+  return out;
+}
+
 // One vertex from the skin of `from` onto the skin of `to`: by its cell's
 // map where the cell persists with a size of the same sign, else projected
 // from where its owning ball took it.
-MovedVertex move_vertex(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
-                        Eigen::Vector3d& p, int& cell) {
+VertexFate move_vertex(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
+                       Eigen::Vector3d& p, int& cell) {
   const MixedCell& c0 = from.cell(cell);
   const int persisting = to.find_cell(c0.balls);
-  MovedVertex out;
   if (persisting >= 0) {
     const MixedCell& c1 = to.cell(persisting);
     const double ratio = c1.R2 / c0.R2;
@@ -155,15 +173,13 @@ MovedVertex move_vertex(const SkinComplex& from, const SkinComplex& to, const st
       if (to.membership_violation(persisting, q) <= kOnBoundary) {
         p = q;
         cell = persisting;
-        return out;
+        return VertexFate::moved;
       }
       const Projection projected = to.project(q, persisting, 1e-14);
-      out.fate = projected.converged ? VertexFate::relocated : VertexFate::lost;
-      if (projected.converged) {
-        p = projected.point;
-        cell = projected.cell;
-      }
-      return out;
+      if (!projected.converged) return VertexFate::lost;
+      p = projected.point;
+      cell = projected.cell;
+      return VertexFate::relocated;
     }
   }
   const int owner = from.owning_ball(p, cell);
@@ -171,14 +187,13 @@ MovedVertex move_vertex(const SkinComplex& from, const SkinComplex& to, const st
       p + (to.balls()[static_cast<size_t>(owner)].center - from.balls()[static_cast<size_t>(owner)].center);
   const int hint = persisting >= 0 ? persisting : to.vertex_cell(owner);
   const Projection projected = to.project(start, hint, 1e-14);
-  out.fate = projected.converged ? VertexFate::relocated : VertexFate::lost;
-  if (projected.converged) {
-    p = projected.point;
-    cell = projected.cell;
-  } else {
+  if (!projected.converged) {
     cell = to.locate(p, hint);  // a valid cell of the new complex for a vertex the remesh drops
+    return VertexFate::lost;
   }
-  return out;
+  p = projected.point;
+  cell = projected.cell;
+  return VertexFate::relocated;
 }
 
 // The critical cells inside the body: z_X lies in its own mixed cell and
@@ -455,41 +470,44 @@ void MovingBalls::step(std::vector<Ball> balls) {
   s.seconds_complex += seconds_since(stage);
   stage = Clock::now();
   SurfaceMesh moved = frame_.mesh;
-  const std::vector<double> longest = longest_edges(moved);
+  const std::vector<Continuity> reach = continuity_bounds(complex_, next, moved, options_.continuity);
   const size_t n = moved.vertices.size();
-  std::vector<MovedVertex> fates(n);
+  std::vector<VertexFate> fates(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
-      const Eigen::Vector3d was = moved.vertices[v];
-      const MixedCell& c0 = complex_.cell(moved.cells[v]);
-      double allowed = 0;  // the largest move of the cell's balls
-      for (int i = 0; i <= c0.dim; ++i) {
-        const size_t b = static_cast<size_t>(c0.balls[static_cast<size_t>(i)]);
-        allowed = std::max(allowed, ball_move(complex_.balls()[b], next.balls()[b]));
-      }
       fates[v] = move_vertex(complex_, next, rotations, moved.vertices[v], moved.cells[v]);
-      fates[v].jumped = (moved.vertices[v] - was).norm() > allowed + options_.continuity * longest[v];
-      if (fates[v].fate != VertexFate::lost)
+      if (fates[v] != VertexFate::lost)
         moved.normals[v] = next.evaluate(moved.vertices[v], moved.cells[v]).gradient.normalized();
     }
   });
   std::vector<char> lost(n, 0), stayed(n, 0);
   for (size_t v = 0; v < n; ++v) {
-    lost[v] = fates[v].fate == VertexFate::lost;
-    stayed[v] = fates[v].fate == VertexFate::moved;
-    s.moved += fates[v].fate == VertexFate::moved;
-    s.relocated += fates[v].fate == VertexFate::relocated;
+    lost[v] = fates[v] == VertexFate::lost;
+    stayed[v] = fates[v] == VertexFate::moved;
+    s.moved += fates[v] == VertexFate::moved;
+    s.relocated += fates[v] == VertexFate::relocated;
     s.lost += lost[v];
-    if (fates[v].jumped && !lost[v]) {
-      frame_.ids[v] = next_id_++;
-      ++s.reidentified;
-    }
   }
+  std::unordered_map<long, size_t> index_before;  // a vertex id -> its index in `reach`
+  index_before.reserve(n);
+  for (size_t v = 0; v < n; ++v) index_before.emplace(frame_.ids[v], v);
   s.seconds_transport += seconds_since(stage);
   stage = Clock::now();
   counting.wait();
   s.seconds_complex += seconds_since(stage);
   repair(next, topology, critical, moved, lost, stayed);
+  // Ids mean continuous motion (moving_balls.hpp): a vertex that
+  // moved farther in the step than its bound, by transport, relaxation,
+  // an edit or a remesh, is another point of the skin and takes a new id.
+  for (size_t v = 0; v < frame_.ids.size(); ++v) {
+    const auto found = index_before.find(frame_.ids[v]);
+    if (found == index_before.end()) continue;
+    const Continuity& c = reach[found->second];
+    if ((frame_.mesh.vertices[v] - c.from).norm() > c.bound) {
+      frame_.ids[v] = next_id_++;
+      ++s.reidentified;
+    }
+  }
   complex_ = std::move(next);
   topology_ = topology;
   critical_ = std::move(critical);
@@ -517,6 +535,7 @@ void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, 
   s.repaired = true;
   s.remeshed = true;
   s.seconds_repair += seconds_since(stage);
+  if (certificate_fault_) certificate_fault_(frame_.mesh, frame_.ids);
   const SkinTopology made = mesh_topology(frame_.mesh);
   if (made != topology)
     throw Error("moving balls: a step's mesh has " + made.text() + " where the skin has " + topology.text() +
@@ -617,6 +636,7 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
   }
   s.seconds_repair += seconds_since(stage);
   if (!because.empty()) return because;
+  if (certificate_fault_) certificate_fault_(moved, frame_.ids);
   const SkinTopology made = mesh_topology(moved);
   if (made != topology) return "the mended mesh has " + made.text() + ", the skin " + topology.text();
   frame_.mesh = std::move(moved);
@@ -649,6 +669,14 @@ bool MovingBalls::drop_vanished(const std::vector<detail::VanishingSphere>& vani
   euler_change += 2 * static_cast<long>(vanished.size());
   return true;
 }
+
+namespace detail {
+
+void inject_certificate_fault(MovingBalls& engine, std::function<void(SurfaceMesh&, std::vector<long>&)> fault) {
+  engine.certificate_fault_ = std::move(fault);
+}
+
+}  // namespace detail
 
 // The whole step remeshed from the moved vertices not dropped (remesh_skin);
 // false when the mesher cannot.

@@ -5,6 +5,8 @@
 // certificate refusing a wrong mesh.
 #include "test_support.hpp"
 
+#include "mesh_part.hpp"
+
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/skin_topology.hpp"
@@ -23,6 +25,13 @@
 #include <unordered_map>
 
 using namespace skinmesh;
+
+namespace Catch {
+template <>
+struct StringMaker<SkinTopology> {
+  static std::string convert(const SkinTopology& t) { return t.text(); }
+};
+}  // namespace Catch
 
 namespace {
 
@@ -181,7 +190,9 @@ TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every 
     if (ubi.atoms[i].residue_number == 65 && ubi.atoms[i].name == "CA") pivot = ubi.atoms[i].position;
   }
   const Eigen::Vector3d axis(0, 0, 1);
-  MovingBalls moving(start);
+  MovingOptions options;
+  options.max_step = 1.0;  // one internal step a frame: the continuity bound below is the step's
+  MovingBalls moving(start, options);
   const int frames = 20;
   const double degrees = 40;
   std::vector<Ball> before = start;
@@ -190,7 +201,29 @@ TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every 
     double atom_move = 0;
     for (size_t i = 0; i < balls.size(); ++i) atom_move = std::max(atom_move, (balls[i].center - before[i].center).norm());
     REQUIRE(atom_move <= 1.0);
+    // Where each vertex id was, and how far it may go and keep its id: the
+    // largest atom move plus its longest edge (MovingOptions::continuity 1).
+    std::unordered_map<long, std::pair<Eigen::Vector3d, double>> was;
+    {
+      const MorphFrame& last = moving.frame();
+      std::vector<double> longest(last.mesh.vertices.size(), 0.0);
+      for (const auto& t : last.mesh.triangles)
+        for (int i = 0; i < 3; ++i) {
+          const auto a = static_cast<size_t>(t[static_cast<size_t>(i)]), b = static_cast<size_t>(t[static_cast<size_t>((i + 1) % 3)]);
+          const double length = (last.mesh.vertices[a] - last.mesh.vertices[b]).norm();
+          longest[a] = std::max(longest[a], length);
+          longest[b] = std::max(longest[b], length);
+        }
+      for (size_t v = 0; v < last.ids.size(); ++v) was[last.ids[v]] = {last.mesh.vertices[v], atom_move + longest[v]};
+    }
     const MorphFrame& f = moving.advance_to(balls, static_cast<double>(k) / frames);
+    REQUIRE(f.stats.steps == 1);
+    long too_far = 0;
+    for (size_t v = 0; v < f.ids.size(); ++v) {
+      const auto found = was.find(f.ids[v]);
+      if (found != was.end()) too_far += (f.mesh.vertices[v] - found->second.first).norm() > found->second.second + 1e-9;
+    }
+    CHECK(too_far == 0);
     INFO("frame " << k << ": " << f.stats.vertices << " vertices, ids kept " << f.stats.ids_kept << ", remeshed "
                    << f.stats.remeshed);
     // A frame remeshed whole (a void vanished that is not a component of its
@@ -259,16 +292,38 @@ TEST_CASE("moving balls: ubiquitin's NMR models 1 -> 2 -> 3 as one motion, ids k
   }
 }
 
-TEST_CASE("the topology certificate refuses a mesh whose bookkeeping is wrong", "[moving]") {
-  const std::vector<Ball> balls = molecule_balls("1ubi.pdb");
-  const MovingBalls moving(balls);
-  const SurfaceMesh& mesh = moving.frame().mesh;
-  REQUIRE(mesh_topology(mesh) == skin_topology(balls));
-  // One component (a void's surface) left out: the count no longer holds.
-  const SurfaceComponents parts = surface_components(mesh);
-  SurfaceMesh wrong = mesh;
-  wrong.triangles.clear();
-  for (size_t f = 0; f < mesh.triangles.size(); ++f)
-    if (parts.of_triangle[f] != parts.of_triangle.back()) wrong.triangles.push_back(mesh.triangles[f]);
-  CHECK_FALSE(mesh_topology(wrong) == skin_topology(balls));
+TEST_CASE("the topology certificate refuses a frame whose bookkeeping is wrong", "[moving]") {
+  // Two separate atoms, one moved a little: no topology change, nothing to
+  // mend. The fault drops the component of the mesh's last vertex, as
+  // bookkeeping that lost a component would.
+  std::vector<Ball> balls{{Eigen::Vector3d::Zero(), 4.0}, {Eigen::Vector3d(6, 0, 0), 4.0}};
+  MovingBalls moving(balls);
+  REQUIRE(mesh_topology(moving.frame().mesh) == SkinTopology{2, 0, 4});
+  const auto drop_a_component = [](SurfaceMesh& mesh, std::vector<long>& ids) {
+    const SurfaceComponents parts = surface_components(mesh);
+    std::vector<char> keep(mesh.triangles.size());
+    for (size_t f = 0; f < keep.size(); ++f) keep[f] = parts.of_triangle[f] != parts.of_triangle.back();
+    std::vector<int> kept_from;
+    mesh = detail::used_part(mesh, keep, kept_from);
+    std::vector<long> kept_ids;
+    for (int v : kept_from) kept_ids.push_back(ids[static_cast<size_t>(v)]);
+    ids = kept_ids;
+  };
+  balls[1].center.x() += 0.3;
+  SECTION("a mended frame that lost a component is not output: the step is remeshed") {
+    int faults = 0;
+    detail::inject_certificate_fault(moving, [&](SurfaceMesh& mesh, std::vector<long>& ids) {
+      if (faults++ == 0) drop_a_component(mesh, ids);
+    });
+    const MorphFrame& f = moving.advance_to(balls, 1);
+    REQUIRE(faults >= 1);
+    CHECK(mesh_topology(f.mesh) == skin_topology(balls));
+    CHECK(f.stats.remeshed);
+    CHECK(f.stats.remeshed_because.find("the mended mesh has") != std::string::npos);
+    CHECK(f.ids.size() == f.mesh.vertices.size());
+  }
+  SECTION("a frame still wrong after the remesh is refused with an error") {
+    detail::inject_certificate_fault(moving, drop_a_component);
+    CHECK_THROWS_WITH(moving.advance_to(balls, 1), Catch::Contains("the frame is refused"));
+  }
 }

@@ -33,6 +33,7 @@
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/relaxation.hpp"
 
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -40,8 +41,13 @@
 
 namespace skinmesh {
 
+class MovingBalls;
+
 namespace detail {
 struct VanishingSphere;  // vanishing.hpp (private to morph/)
+// For tests only: `fault` is applied to every
+// mesh of a step, with its ids, just before the topology certificate.
+void inject_certificate_fault(MovingBalls& engine, std::function<void(SurfaceMesh&, std::vector<long>&)> fault);
 }  // namespace detail
 
 struct MovingOptions {
@@ -103,6 +109,7 @@ class MovingBalls {
                      SurfaceMesh& moved, std::vector<char>& lost, long& euler_change);
   bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
   MeshingOptions repair_criteria() const { return options_.frames; }
+  friend void detail::inject_certificate_fault(MovingBalls&, std::function<void(SurfaceMesh&, std::vector<long>&)>);
 
   MovingOptions options_;
   SkinComplex complex_;
@@ -111,6 +118,7 @@ class MovingBalls {
   MorphFrame frame_;
   long next_id_ = 0;
   std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;  // detail::RefusedEdges
+  std::function<void(SurfaceMesh&, std::vector<long>&)> certificate_fault_;  // tests only: none
 };
 
 // Components, voids and Euler characteristic of a closed triangle mesh
