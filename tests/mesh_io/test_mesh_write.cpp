@@ -7,6 +7,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <iterator>
+#include <sstream>
+
 #include <fstream>
 
 using namespace skinmesh;
@@ -64,6 +67,38 @@ TEST_CASE("written meshes read back with the same vertices and triangles", "[io]
       write_msms_face(out_face, m, &attributes);
     }
     const SurfaceMesh back = read_surface_mesh(vert.path());
+    // MSMS's columns: the closest atom (1-based) eighth, the face type
+    // (1 contact, 2 toric, 3 spheric reentrant) ninth; a face's type fourth.
+    const auto data_lines = [](const std::string& path) {
+      std::ifstream in(path);
+      std::vector<std::vector<std::string>> rows;
+      std::string line;
+      bool count_seen = false;
+      while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        if (!count_seen) {
+          count_seen = true;
+          continue;
+        }
+        std::istringstream words(line);
+        rows.emplace_back(std::istream_iterator<std::string>(words), std::istream_iterator<std::string>());
+      }
+      return rows;
+    };
+    const auto vertex_rows = data_lines(vert.path());
+    REQUIRE(vertex_rows.size() == m.vertices.size());
+    const int type_of_patch[] = {1, 2, 3, 3};
+    for (size_t v = 0; v < vertex_rows.size(); ++v) {
+      REQUIRE(vertex_rows[v].size() == 9);
+      CHECK(vertex_rows[v][7] == std::to_string(attributes.atom[v] + 1));
+      CHECK(vertex_rows[v][8] == std::to_string(type_of_patch[attributes.patch[v]]));
+    }
+    const auto face_rows = data_lines(face);
+    REQUIRE(face_rows.size() == m.triangles.size());
+    for (size_t f = 0; f < face_rows.size(); ++f) {
+      REQUIRE(face_rows[f].size() == 5);
+      CHECK(face_rows[f][3] == std::to_string(type_of_patch[attributes.patch[static_cast<size_t>(m.triangles[f][0])]]));
+    }
     std::remove(face.c_str());
     REQUIRE(back.vertices.size() == m.vertices.size());
     CHECK(back.triangles == m.triangles);

@@ -212,6 +212,16 @@ void write_mesh(std::ostream& out, const SurfaceMesh& mesh, MeshFormat format, c
   if (!out) output_error("", "writing the mesh failed");
 }
 
+// MSMS's face types (its man page): 1 a contact face (on one atom), 2 a
+// toric reentrant face (two atoms), 3 a spheric reentrant face (three). The
+// skin's patches by the dimension of their Delaunay simplex: a vertex's
+// sphere patch is convex on its atom (1), an edge's hyperboloid is the
+// saddle between two atoms (2), a triangle's hyperboloid and a
+// tetrahedron's sphere patch are concave between three or four (3).
+namespace {
+int msms_face_type(int patch) { return patch <= 0 ? 1 : patch == 1 ? 2 : 3; }
+}  // namespace
+
 void write_msms_vert(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
                      const MeshWriteOptions& options) {
   const bool attrs = has(attributes, mesh);
@@ -219,21 +229,27 @@ void write_msms_vert(std::ostream& out, const SurfaceMesh& mesh, const VertexAtt
       << "#vertex #sphere density probe_r\n"
       << mesh.vertices.size() << " " << 0 << " " << 0 << " " << 0 << "\n"
       << std::setprecision(digits(options));
+  // As MSMS writes them: x y z nx ny nz, the analytic face (0: the skin has
+  // none numbered), the closest atom (1-based; 0 unknown), the face type.
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Eigen::Vector3d& p = mesh.vertices[v];
     const Eigen::Vector3d n = normal_of(mesh, v);
     out << p[0] << " " << p[1] << " " << p[2] << " " << n[0] << " " << n[1] << " " << n[2] << " 0 "
-        << (attrs ? attributes->patch[v] : 0) << " " << (attrs ? attributes->atom[v] + 1 : 0) << "\n";
+        << (attrs ? attributes->atom[v] + 1 : 0) << " " << msms_face_type(attrs ? attributes->patch[v] : 0) << "\n";
   }
   if (!out) output_error("", "writing the MSMS vertices failed");
 }
 
+// As MSMS writes them: three 1-based corners, the face type (of the
+// triangle's first corner), the analytic face (0: none numbered).
 void write_msms_face(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes) {
-  (void)attributes;
+  const bool attrs = has(attributes, mesh);
   out << "# MSMS-format triangles written by skinmesh (molecular skin surface)\n"
       << "#faces #sphere density probe_r\n"
       << mesh.triangles.size() << " 0 0 0\n";
-  for (const auto& t : mesh.triangles) out << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << " 1 1\n";
+  for (const auto& t : mesh.triangles)
+    out << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << " "
+        << msms_face_type(attrs ? attributes->patch[static_cast<size_t>(t[0])] : 0) << " 0\n";
   if (!out) output_error("", "writing the MSMS triangles failed");
 }
 
