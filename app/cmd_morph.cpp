@@ -61,7 +61,7 @@ struct MorphCommandOptions {
 void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
   cmd.add_option("source", o.source, "source molecule (any format a molecule is read from)")->required();
   cmd.add_option("target", o.target, "target molecule")->required();
-  cmd.add_option("--output,-o", o.directory, "output directory (made if missing; must hold no frames already)")
+  cmd.add_option("--output,-o", o.directory, "output directory (made if missing; one holding an earlier run's frames is refused)")
       ->required();
   cmd.add_option("--frames", o.frames, "frames at t = 0, 1/(N-1), ..., 1")
       ->check(finite_number())->check(CLI::Range(2, 100000))->capture_default_str();

@@ -41,7 +41,7 @@ struct TrajectoryOptions {
 
 void add_trajectory_options(CLI::App& cmd, TrajectoryOptions& o) {
   cmd.add_option("molecule", o.molecule.path, "multi-model PDB or mmCIF (optionally .gz)")->required();
-  cmd.add_option("--output,-o", o.directory, "output directory (made if missing)")->required();
+  cmd.add_option("--output,-o", o.directory, "output directory (made if missing; one holding an earlier run's frames is refused)")->required();
   cmd.add_option("--models", o.models, "models to take, 1-based: a range A-B or a list A,B,C (default: all)");
   cmd.add_option("--every", o.every, "take every K-th of those models")
       ->check(finite_number())->check(CLI::Range(1, 1000000))->capture_default_str();

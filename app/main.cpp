@@ -2,12 +2,15 @@
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "interrupt.hpp"
+#include "output_file.hpp"
+#include "suggest.hpp"
 
 #include "skinmesh/core/allocator.hpp"
 #include "skinmesh/core/error.hpp"
 
 #include <iostream>
 #include <string>
+#include <vector>
 
 const char* skinmesh::app::version_text() {
 #ifdef SKINMESH_COMMIT
@@ -39,7 +42,15 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version end the parse with code 0; every usage error is
+    // a bad option (exit 2), with the nearest name when one was mistyped.
+    if (app.exit(e) == 0) return 0;
+    const std::string hint = skinmesh::app::suggestion(app, std::vector<std::string>(argv + 1, argv + argc));
+    if (!hint.empty()) std::cerr << "skinmesh: " << hint << "\n";
+    return code(skinmesh::app::ExitCode::bad_input);
+  } catch (const skinmesh::app::UnusableOutput& e) {
+    std::cerr << "skinmesh: error: " << e.what() << "\n";
+    return code(skinmesh::app::ExitCode::bad_input);
   } catch (const skinmesh::InputError& e) {
     std::cerr << "skinmesh: error: " << e.what() << "\n";
     return code(skinmesh::app::ExitCode::bad_input);

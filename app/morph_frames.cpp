@@ -1,5 +1,6 @@
 #include "morph_frames.hpp"
 
+#include "output_file.hpp"
 #include "quality_report.hpp"
 
 #include "skinmesh/core/error.hpp"
@@ -27,10 +28,19 @@ using json = nlohmann::json;
 OutputDirectory::OutputDirectory(const std::string& path) : path_(path) {
   std::error_code error;
   if (fs::exists(path_, error)) {
-    if (!fs::is_directory(path_, error)) output_error(path, "exists and is not a directory");
+    if (!fs::is_directory(path_, error)) unusable_output(path, "exists and is not a directory");
+    // Frames of an earlier run would be mixed with this run's (its extra
+    // frames left behind): refused before any work.
+    for (const auto& entry : fs::directory_iterator(path_, error)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("frame_", 0) == 0 || name == "frames.jsonl" || name == "frames.pvd" || name == "morph.json" ||
+          name == "trajectory.json")
+        unusable_output(path, "holds an earlier run's output (" + name +
+                                  "); remove it or choose a directory without frames");
+    }
   } else {
     made_ = fs::create_directory(path_, error);
-    if (!made_) output_error(path, "cannot make the output directory (" + error.message() + ")");
+    if (!made_) unusable_output(path, "cannot make the output directory (" + error.message() + ")");
     removed_on_interrupt_.emplace_back(path_.string());
   }
 }

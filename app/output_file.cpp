@@ -11,6 +11,10 @@
 
 namespace skinmesh::app {
 
+void unusable_output(const std::string& path, const std::string& message) {
+  throw UnusableOutput(path + ": " + message);
+}
+
 OutputSet::~OutputSet() {
   for (const Staged& s : staged_) std::remove(s.temporary.c_str());
 }
@@ -41,10 +45,10 @@ void OutputSet::commit() {
 void check_writable(const std::vector<std::string>& paths) {
   for (const std::string& path : paths) {
     struct stat info {};
-    if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) output_error(path, "is a directory");
+    if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) unusable_output(path, "is a directory");
     const std::string probe = path + ".tmp-" + std::to_string(::getpid());
     std::ofstream out(probe, std::ios::binary | std::ios::trunc);
-    if (!out) output_error(path, std::string("cannot write (") + std::strerror(errno) + ")");
+    if (!out) unusable_output(path, std::string("cannot write (") + std::strerror(errno) + ")");
     out.close();
     std::remove(probe.c_str());
   }

@@ -7,12 +7,24 @@
 
 #include "interrupt.hpp"
 
+#include "skinmesh/core/error.hpp"
+
 #include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 namespace skinmesh::app {
+
+// An output named on the command line that cannot be used (a path that
+// cannot be written, a directory holding an earlier run's frames), found
+// before any work: a bad option (exit 2). An OutputError while writing is
+// the system refusing (exit 1).
+class UnusableOutput : public OutputError {
+ public:
+  using OutputError::OutputError;
+};
+[[noreturn]] void unusable_output(const std::string& path, const std::string& message);
 
 class OutputSet {
  public:
@@ -36,7 +48,7 @@ class OutputSet {
 };
 
 // Checks, before any work, that each path can be written: not a directory,
-// in a folder that exists and takes a new file. Throws OutputError naming the
+// in a folder that exists and takes a new file. Throws UnusableOutput naming the
 // first that cannot; leaves nothing behind.
 void check_writable(const std::vector<std::string>& paths);
 

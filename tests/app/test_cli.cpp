@@ -308,16 +308,60 @@ TEST_CASE("outputs that cannot be written are refused before the work", "[cli][b
   skinmesh::test::TempFile mesh("m.ply");
   std::remove(mesh.path().c_str());
   const Run r = run("--quiet mesh " + pept + " -o " + mesh.path() + " --report " + folder);
-  CHECK(r.code != 0);
+  CHECK(r.code == 2);  // a bad option (docs/commands.md, exit codes)
   CHECK(r.output.find("is a directory") != std::string::npos);
   CHECK_FALSE(std::ifstream(mesh.path()).good());
   // A folder that does not exist, for the mesh and for a volume stem.
   const Run nowhere = run("--quiet mesh " + pept + " -o /nonexistent-skinmesh/m.ply");
-  CHECK(nowhere.code != 0);
+  CHECK(nowhere.code == 2);
   CHECK(nowhere.output.find("/nonexistent-skinmesh/m.ply") != std::string::npos);
   const Run volume = run("--quiet volume " + pept + " -o /nonexistent-skinmesh/v");
-  CHECK(volume.code != 0);
+  CHECK(volume.code == 2);
   CHECK(volume.output.find("cannot write") != std::string::npos);
+}
+
+TEST_CASE("every usage error exits 2, and a mistyped command or option is told the nearest name", "[cli][bad]") {
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  skinmesh::test::TempFile out("never.off");
+  std::remove(out.path().c_str());
+  struct Case {
+    std::string args, says;
+  };
+  const std::vector<Case> cases{
+      {"msh " + pept, "did you mean 'mesh'?"},                                        // no such command
+      {"mesh " + pept + " -o " + out.path() + " --edge-lenght 1", "did you mean '--edge-length'?"},  // no such option
+      {"morph " + pept + " --frame 3 -o " + out.path(), "did you mean '--frames'?"},   // and a required one missing
+      {"mesh " + pept + " -o " + out.path() + " --min-angle abc", "min-angle"},     // not a number
+      {"mesh " + pept + " -o " + out.path() + " --min-angle", "min-angle"},          // an option without its value
+      {"mesh", "required"},                                                          // the input missing
+      {"", "subcommand"},                                                            // no command
+  };
+  for (const Case& c : cases) {
+    INFO(c.args);
+    const Run r = run(c.args);
+    CHECK(r.code == 2);
+    CHECK(r.output.find(c.says) != std::string::npos);
+  }
+  CHECK_FALSE(std::ifstream(out.path()).good());
+  CHECK(run("mesh --help").code == 0);
+  CHECK(run("--version").code == 0);
+}
+
+TEST_CASE("morph refuses a directory holding an earlier run's frames, before any work", "[cli][bad][morph]") {
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  skinmesh::test::TempFile holder("x");
+  const std::string dir = holder.path() + "-earlier-run";
+  std::filesystem::create_directory(dir);
+  { std::ofstream(dir + "/frame_0007.ply") << "an earlier run's frame"; }
+  const Run r = run("--quiet morph " + pept + " " + pept + " --frames 3 -o " + dir);
+  CHECK(r.code == 2);
+  CHECK(r.output.find("frame_0007.ply") != std::string::npos);
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) files += entry.is_regular_file();
+  CHECK(files == 1);  // nothing written beside it
+  const Run t = run("--quiet trajectory " + skinmesh::test::data_file("2k39_3models.pdb") + " -o " + dir);
+  CHECK(t.code == 2);
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("interpolate --all-pairs refuses a set that would not fit, at once", "[cli][bad]") {
