@@ -51,8 +51,8 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
   cmd->add_option("--output,-o", o->output, "output weighted points file (.wpts: x y z w per line)")->required();
   cmd->add_flag("--all-pairs", o->all, "keep all m*n pairs (default: live pairs only, hidden ones dropped)");
   cmd->add_flag("--centre,--center", o->centre, "move each molecule's centroid to the origin first");
-  cmd->add_option("--source-model", o->source_model, "1-based model of the source file")->check(finite_number())->check(CLI::PositiveNumber);
-  cmd->add_option("--target-model", o->target_model, "1-based model of the target file")->check(finite_number())->check(CLI::PositiveNumber);
+  cmd->add_option("--source-model", o->source_model, "1-based model of the source file")->check(finite_number())->check(positive_number());
+  cmd->add_option("--target-model", o->target_model, "1-based model of the target file")->check(finite_number())->check(positive_number());
   add_molecule_settings(*cmd, o->molecule);
   cmd->callback([o, &global, &exit_code]() {
     if (!has_extension(lowercase(o->output), ".wpts"))

@@ -54,34 +54,34 @@ void add_mesh_options(CLI::App& cmd, MeshCommandOptions& o) {
       ->check(finite_number())->check(CLI::Range(1.0, 30.0))
       ->capture_default_str();
   cmd.add_option("--epsilon", o.meshing.sizing.epsilon, "curvature-relative size: edge length / local radius of curvature")
-      ->check(finite_number())->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(positive_number())
       ->capture_default_str();
   cmd.add_option("--edge-length", o.meshing.edge_length,
                  "largest edge length in Angstrom, uniform wherever the curvature allows it (--epsilon still "
-                 "bounds it where the skin bends more, which keeps the topology)")
-      ->check(finite_number())->check(CLI::PositiveNumber);
+                 "bounds it where the skin bends more, which keeps the topology); 0: none, curvature only")
+      ->check(finite_number())->check(non_negative_number())->capture_default_str();
   cmd.add_option("--contract-below", o.meshing.contract_below,
                  "clean-up: contract edges shorter than this times the local target length (0: off)")
       ->check(finite_number())->check(CLI::Range(0.0, 0.99))
       ->capture_default_str();
   cmd.add_option("--min-size", o.meshing.sizing.min_size, "smallest target edge length on hyperboloid patches, A")
-      ->check(finite_number())->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(positive_number())
       ->capture_default_str();
   cmd.add_option("--max-size", o.meshing.sizing.max_size, "largest target edge length, A")
-      ->check(finite_number())->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(positive_number())
       ->capture_default_str();
   cmd.add_option("--tolerance", o.meshing.tolerance,
                  "largest distance from a triangle's circumcentre to the skin along its normal, A")
-      ->check(finite_number())->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(positive_number())
       ->capture_default_str();
   cmd.add_option("--max-triangles", o.meshing.max_triangles, "stop with an error past this many triangles")
-      ->check(finite_number())->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(positive_number())
       ->capture_default_str();
   cmd.add_option("--max-memory", o.max_memory_gb,
                  "refuse at once a job whose estimated memory passes this many GB (0: the memory available now)")
-      ->check(finite_number())->check(CLI::NonNegativeNumber)
+      ->check(finite_number())->check(non_negative_number())
       ->capture_default_str();
-  cmd.add_option("--threads", o.meshing.threads, "threads for the parallel passes (0: all)")->check(finite_number())->check(CLI::NonNegativeNumber);
+  cmd.add_option("--threads", o.meshing.threads, "threads for the parallel passes (0: all)")->check(finite_number())->check(non_negative_number());
   cmd.add_flag("--float", o.single_precision, "write single-precision coordinates (smaller files)");
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
 }

@@ -68,9 +68,9 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
   cmd.add_option("--t", o.times, "frame times in [0, 1] instead of --frames (comma-separated, increasing)")
       ->delimiter(',')->check(finite_number())->check(CLI::Range(0.0, 1.0));
   cmd.add_option("--source-model", o.source_model, "1-based model of the source file")
-      ->check(finite_number())->check(CLI::PositiveNumber);
+      ->check(finite_number())->check(positive_number());
   cmd.add_option("--target-model", o.target_model, "1-based model of the target file")
-      ->check(finite_number())->check(CLI::PositiveNumber);
+      ->check(finite_number())->check(positive_number());
   cmd.add_option("--align", o.align,
                  "auto (Kabsch on matched atoms when both sides are the same molecule, centroid otherwise), "
                  "none, centroid or kabsch")
@@ -84,19 +84,19 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
                  "centre plus skin radius)")
       ->check(CLI::IsMember({"uniform", "change"}))->capture_default_str();
   cmd.add_option("--max-step", o.max_step, "--pairs matched: largest move of an atom in one internal step, A")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--min-angle", o.morph.frames.min_angle, "smallest angle of every triangle of every frame, degrees")
       ->check(finite_number())->check(CLI::Range(1.0, 30.0))->capture_default_str();
   cmd.add_option("--epsilon", o.morph.first.sizing.epsilon, "curvature-relative size (edge / radius of curvature)")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--edge-length", o.morph.first.edge_length, "largest edge length in Angstrom (0: curvature only)")
-      ->check(finite_number())->check(CLI::NonNegativeNumber);
+      ->check(finite_number())->check(non_negative_number());
   cmd.add_option("--tolerance", o.morph.first.tolerance, "largest circumcentre distance from the skin, A")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--max-triangles", o.morph.first.max_triangles, "stop with an error past this many triangles")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--threads", o.morph.first.threads, "threads (0: all)")
-      ->check(finite_number())->check(CLI::NonNegativeNumber);
+      ->check(finite_number())->check(non_negative_number());
   cmd.add_option("--format", o.formats, "mesh formats per frame, comma-separated: ply vtp off obj stl "
                                         "(frames.pvd needs vtp)")
       ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl"}))->capture_default_str();

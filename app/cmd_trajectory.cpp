@@ -52,15 +52,15 @@ void add_trajectory_options(CLI::App& cmd, TrajectoryOptions& o) {
   cmd.add_option("--min-angle", o.moving.frames.min_angle, "smallest angle of every triangle of every later frame, degrees")
       ->check(finite_number())->check(CLI::Range(1.0, 30.0))->capture_default_str();
   cmd.add_option("--epsilon", o.moving.first.sizing.epsilon, "curvature-relative size (edge / radius of curvature)")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--edge-length", o.moving.first.edge_length, "largest edge length in Angstrom (0: curvature only)")
-      ->check(finite_number())->check(CLI::NonNegativeNumber)->capture_default_str();
+      ->check(finite_number())->check(non_negative_number())->capture_default_str();
   cmd.add_option("--tolerance", o.moving.first.tolerance, "largest circumcentre distance from the skin, A")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--max-step", o.moving.max_step, "largest move of an atom in one internal step, A")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--max-triangles", o.moving.first.max_triangles, "stop with an error past this many triangles")
-      ->check(finite_number())->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--format", o.formats, "mesh formats per frame, comma-separated: ply vtp off obj stl")
       ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl"}))->capture_default_str();
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");

@@ -44,7 +44,7 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
       ->check(CLI::IsMember({"interior", "exterior", "both"}))
       ->capture_default_str();
   cmd.add_option("--box-margin", o.volume.box_margin, "Angstrom between the skin's bounding box and the outer box")
-      ->check(finite_number())->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(positive_number())
       ->capture_default_str();
   cmd.add_option("--max-radius-edge", o.volume.bounds.max_radius_edge, "largest circumradius / shortest edge of a tetrahedron")
       ->check(finite_number())->check(CLI::Range(1.0, 10.0))
@@ -53,21 +53,21 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
       ->check(finite_number())->check(CLI::Range(0.0, 16.0))
       ->capture_default_str();
   cmd.add_option("--max-volume", o.volume.max_volume, "largest tetrahedron, A^3 (0: no bound)")
-      ->check(finite_number())->check(CLI::NonNegativeNumber)
+      ->check(finite_number())->check(non_negative_number())
       ->capture_default_str();
   cmd.add_option("--max-tetrahedra", o.volume.max_tetrahedra,
                  "refuse a --max-volume that asks for more tetrahedra than this (domain volume / max volume)")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->capture_default_str();
   cmd.add_flag("--drop-cavities", o.drop_cavities, "fill enclosed voids instead of keeping their surfaces");
   cmd.add_option("--epsilon", o.meshing.sizing.epsilon, "surface: edge length / local radius of curvature")
-      ->check(finite_number())->check(CLI::PositiveNumber)
+      ->check(finite_number())->check(positive_number())
       ->capture_default_str();
-  cmd.add_option("--edge-length", o.meshing.edge_length, "surface: largest edge length, A")->check(finite_number())->check(CLI::PositiveNumber);
+  cmd.add_option("--edge-length", o.meshing.edge_length, "surface: largest edge length, A (0: none, curvature only)")->check(finite_number())->check(non_negative_number())->capture_default_str();
   cmd.add_option("--max-memory", o.max_memory_gb,
                  "surface: refuse at once a skin mesh whose estimated memory passes this many GB (0: the memory "
                  "available now)")
-      ->check(finite_number())->check(CLI::NonNegativeNumber)
+      ->check(finite_number())->check(non_negative_number())
       ->capture_default_str();
 }
 

@@ -36,6 +36,25 @@ inline const CLI::Validator& finite_number() {
   return check;
 }
 
+// A number above 0, or at least 0: CLI11's PositiveNumber and
+// NonNegativeNumber state their range with the largest double written out.
+inline const CLI::Validator& positive_number() {
+  static const CLI::Validator check(
+      [](std::string& text) -> std::string {
+        return std::strtod(text.c_str(), nullptr) > 0 ? "" : "must be greater than 0, not " + text;
+      },
+      "POSITIVE");
+  return check;
+}
+inline const CLI::Validator& non_negative_number() {
+  static const CLI::Validator check(
+      [](std::string& text) -> std::string {
+        return std::strtod(text.c_str(), nullptr) >= 0 ? "" : "must be 0 or more, not " + text;
+      },
+      "NON-NEGATIVE");
+  return check;
+}
+
 // Adds subcommand `name`: its options are declared on an Options struct by
 // add_options, and the callback runs `run` with them and sets `exit_code`.
 template <class Options>

@@ -20,6 +20,24 @@ const char* skinmesh::app::version_text() {
 #endif
 }
 
+namespace {
+
+// One example a command, at the end of its --help.
+void add_examples(CLI::App& app) {
+  const std::pair<const char*, const char*> examples[] = {
+      {"info", "skinmesh info data/1ubi.pdb"},
+      {"mesh", "skinmesh mesh data/1ubi.pdb -o ubi.ply --report ubi.json"},
+      {"quality", "skinmesh quality ubi.ply --molecule data/1ubi.pdb --svg ubi.svg"},
+      {"volume", "skinmesh volume data/pept.pdb -o pept --domain both --box-margin 4"},
+      {"interpolate", "skinmesh interpolate data/pept.pdb data/3al1.pdb --t 0.5 -o half.wpts"},
+      {"morph", "skinmesh morph data/2k39_3models.pdb data/2k39_3models.pdb --target-model 3 -o morph/"},
+      {"trajectory", "skinmesh trajectory data/2k39_3models.pdb -o ensemble/ --frames-per-step 5"},
+  };
+  for (const auto& [name, example] : examples) app.get_subcommand(name)->footer(std::string("Example:\n  ") + example);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   skinmesh::app::watch_interrupts();  // first: before any thread starts
   skinmesh::return_large_blocks_to_system();
@@ -29,8 +47,11 @@ int main(int argc, char** argv) {
   skinmesh::app::GlobalOptions global;
   for (int i = 0; i < argc; ++i) global.command_line += (i ? " " : "") + std::string(argv[i]);
   app.set_version_flag("--version", std::string("skinmesh ") + skinmesh::app::version_text());
-  app.add_flag("--json", global.json, "machine-readable JSON on stdout");
-  app.add_flag("--quiet,-q", global.quiet, "no progress or warnings on the terminal");
+  app.option_defaults()->always_capture_default();  // every option's help shows its default
+  app.add_flag("--json", global.json, "machine-readable JSON on stdout (before or after the command)");
+  app.add_flag("--quiet,-q", global.quiet,
+               "no progress, warnings or summary on the terminal (before or after the command); the outputs, "
+               "--json and the exit code still say how it went");
   int exit_code = code(skinmesh::app::ExitCode::ok);
   skinmesh::app::add_info_command(app, global, exit_code);
   skinmesh::app::add_mesh_command(app, global, exit_code);
@@ -39,6 +60,7 @@ int main(int argc, char** argv) {
   skinmesh::app::add_interpolate_command(app, global, exit_code);
   skinmesh::app::add_morph_command(app, global, exit_code);
   skinmesh::app::add_trajectory_command(app, global, exit_code);
+  add_examples(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -333,6 +333,8 @@ TEST_CASE("every usage error exits 2, and a mistyped command or option is told t
       {"morph " + pept + " --frame 3 -o " + out.path(), "did you mean '--frames'?"},   // and a required one missing
       {"mesh " + pept + " -o " + out.path() + " --min-angle abc", "min-angle"},     // not a number
       {"mesh " + pept + " -o " + out.path() + " --min-angle", "min-angle"},          // an option without its value
+      {"mesh " + pept + " -o " + out.path() + " --tolerance 0", "must be greater than 0, not 0"},  // out of range
+      {"mesh " + pept + " -o " + out.path() + " --edge-length -1", "must be 0 or more, not -1"},
       {"mesh", "required"},                                                          // the input missing
       {"", "subcommand"},                                                            // no command
   };
@@ -343,6 +345,10 @@ TEST_CASE("every usage error exits 2, and a mistyped command or option is told t
     CHECK(r.output.find(c.says) != std::string::npos);
   }
   CHECK_FALSE(std::ifstream(out.path()).good());
+  for (const Case& c : cases) CHECK(run(c.args).output.size() < 400);  // no range written with 300 digits
+  // --edge-length 0 means the same in every command: no cap, curvature only.
+  CHECK(run("--quiet mesh " + pept + " -o " + out.path() + " --edge-length 0").code == 0);
+  std::remove(out.path().c_str());
   CHECK(run("mesh --help").code == 0);
   CHECK(run("--version").code == 0);
 }
@@ -757,4 +763,27 @@ TEST_CASE("an interrupted command leaves no output behind", "[cli][bad][interrup
     CHECK(std::filesystem::is_empty(pattern));
     std::filesystem::remove_all(pattern);
   }
+}
+
+TEST_CASE("the example at the end of every command's help runs as written", "[cli]") {
+  const std::string data = skinmesh::test::data_file("pept.pdb").substr(0, skinmesh::test::data_file("pept.pdb").rfind('/') + 1);
+  skinmesh::test::TempFile holder("x");
+  const std::string dir = holder.path() + "-examples";
+  std::filesystem::create_directory(dir);
+  // In the order that makes what a later example reads (quality reads mesh's output).
+  for (const char* command : {"info", "mesh", "quality", "volume", "interpolate", "morph", "trajectory"}) {
+    INFO(command);
+    const Run help = run(std::string(command) + " --help");
+    const size_t at = help.output.find("Example:\n  ");
+    REQUIRE(at != std::string::npos);
+    std::string example = help.output.substr(at + 11);
+    example = example.substr(0, example.find('\n'));
+    REQUIRE(example.rfind("skinmesh ", 0) == 0);
+    for (size_t p = example.find("data/"); p != std::string::npos; p = example.find("data/", p + data.size()))
+      example.replace(p, 5, data);
+    const std::string line = "cd " + dir + " && " + SKINMESH_BINARY + " --quiet " + example.substr(9) + " > /dev/null 2>&1";
+    INFO(line);
+    CHECK(std::system(line.c_str()) == 0);
+  }
+  std::filesystem::remove_all(dir);
 }
