@@ -122,8 +122,7 @@ void add_nearby_context(const SurfaceMesh& mesh, const std::vector<char>& region
     if (role[static_cast<size_t>(v)] == kNone) grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and one stretched triangle
-  // makes the reach long. On 1ubi -> 1hpv (t = 0.39 in 100 frames) the list
-  // took 805 MB, twice what the rest of the morph holds (heaptrack).
+  // makes the reach long, so the list could outgrow the rest of the morph.
   const auto context = static_cast<signed char>(PatchRole::context);
   for (size_t v = 0; v < role.size(); ++v) {
     if (role[v] == kNone || role[v] == context) continue;

@@ -9,10 +9,8 @@
 // failing for the local repair (local_repair.hpp) or the frame's remesh.
 //
 // Why: a local repair builds a Delaunay triangulation of its patch with
-// context, about 2,000-4,000 points for a step of pept -> 3al1 at 2% of
-// the triangles failing, and CGAL inserts skin samples at about 4.5
-// microseconds a point here; a patch cost 20-70 ms, as much as remeshing
-// the whole frame (docs/morph.md, "Mending by edits").
+// its context, which costs about as much as remeshing the whole frame,
+// however few triangles fail (docs/morph.md, "Mending by edits").
 #pragma once
 
 #include "skinmesh/core/skin_complex.hpp"
