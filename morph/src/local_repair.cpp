@@ -101,10 +101,8 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
 // across a thin gap, the far side of a narrow neck) become context too.
 // Without them the Voronoi edge of a patch facet runs on across the gap, its
 // restricted point lies on the other sheet, and refinement meshes that sheet
-// a second time: `skinmesh morph` of 2k39 model 1 -> 3 in 100 frames
-// (Kabsch) tried 73 local repairs, and 7 failed so (4 changed the topology,
-// 3 "needed more than twice its own points"), each then remeshing the whole
-// frame; with them, none failed. Near: within twice the longest edge of the
+// a second time: the repair fails (a wrong topology, or too many points)
+// and the whole frame is remeshed. Near: within twice the longest edge of the
 // region's triangles, about the diameter of a patch facet's surface
 // Delaunay ball.
 void add_nearby_context(const SurfaceMesh& mesh, const std::vector<char>& region, std::vector<signed char>& role) {

@@ -40,9 +40,9 @@ struct SurgeryOptions {
   double thin_below = 0.5;
   // A thinning contraction refused in an earlier frame is tried again only
   // when its edge has shrunk by this share since, or after this many frames.
-  // Most short edges are refused frame after frame (2k39 model 1 -> 3: about
-  // 750 tried a frame, 93% refused, each judging up to a fan of triangles):
-  // they are short by design where the mesh was refined with room.
+  // Most short edges are refused frame after frame, each refusal judging a
+  // fan of triangles: they are short by design where the mesh was refined
+  // with room. A share (dimensionless) and a count of frames.
   double retry_shrink = 0.05;
   int retry_after_frames = 8;
 };
