@@ -174,10 +174,9 @@ struct FrameReference {
 
 // Each vertex's distance to the skin of B(t) by the morph oracle, which
 // knows neither the morph's complex nor its live pairs. Very near an end
-// the oracle may not certify a point (on 2k39 model 1 -> 3, centred, two
-// vertices of the frame at t = 0.9999 with a KKT gap of 3e-6 and a distance
-// of 4.3e-6 A, where B(t)'s own complex put them 7.5e-17 and 4.9e-16 A off
-// and the overlay complex as close): those vertices are measured instead on
+// the oracle may not certify a point (a KKT gap left, where B(t)'s own
+// complex and the overlay complex put the point on the skin; docs/morph.md,
+// "What is not there yet"): those vertices are measured instead on
 // the complex of B(t)'s balls built from scratch (a regular triangulation,
 // not the morph's overlay), and counted in `uncertified`.
 double largest_error(const SurfaceMesh& mesh, const FrameReference& reference, double t, long& uncertified) {

@@ -28,9 +28,9 @@ using Regular = detail::RegularTriangulation<int>;
 // Whether a Gram matrix's smallest eigenvalue is surely above 1e-14 times its
 // largest (the flat test below) without solving for them: the smallest is at
 // least det / largest^(d-1) and the largest at most the trace, so
-// det > 1e-10 trace^d leaves four orders of magnitude for rounding. 99% of
-// the cells of a morph's frames pass (pept -> 3al1), and moving its complex
-// took 8.5 ms a frame instead of 11.1 with the eigenvalues of every cell.
+// det > 1e-10 trace^d leaves four orders of magnitude for rounding. Nearly
+// every cell of a morph's frames passes, which spares moving the complex the
+// eigenvalues of nearly every cell.
 template <class Mat>
 bool clearly_not_flat(const Mat& g) {
   const double trace = g.trace();
@@ -48,15 +48,13 @@ bool clearly_not_flat(const Mat& g) {
 // The geometry of a simplex that is not flat from E's columns, the edges
 // from the first ball: 2 <z - z_0, e_j> = rhs_j with z - z_0 = E a. Solved
 // through the normal equations (E^T E) a = rhs / 2, the error grows with the
-// square of E's condition: a tetrahedron of 1ubi -> 1hpv whose target side is
-// nearly flat had its size 1e-8 A^2 off at every t, and the morph's frame at
-// t = 0.99 a vertex 2.6e-8 A off the skin by the morph oracle, B(t)'s exact
-// orthosphere (GMP) and CGAL's skin sign (bench/morph_precision). Here it
-// grows with the condition itself: with E = QR (thin), R^T (R a) = rhs / 2,
+// square of E's condition: enough, for an overlay tetrahedron with a nearly
+// flat side, to put a morph frame's vertex off the skin by more than a
+// frame is held to (bench/morph_precision). Here it grows with the
+// condition itself: with E = QR (thin), R^T (R a) = rhs / 2,
 // so z - z_0 = Q R^-T rhs / 2, P = Q Q^T and the affine coordinates are
 // R^-1 Q^T. A tetrahedron's E is square: z - z_0 = E^-T rhs / 2, P = I and
-// the affine coordinates E^-1 (Householder QR for it made 2k39 model 1 -> 3
-// 8% slower a frame).
+// the affine coordinates E^-1 (by LU: Householder QR made frames slower).
 void set_geometry(MixedCell& cell, const Ball& b0, const Eigen::Vector3d& offset) {
   cell.center = b0.center + offset;
   cell.R2 = offset.squaredNorm() - b0.weight;
@@ -99,7 +97,7 @@ void solve_not_flat(MixedCell& cell, const Ball& b0, const Eigen::Matrix<double,
 // the projector onto the directions of aff(delta_X) (docs/math.md section 3),
 // for a simplex of D+1 balls. Fixed-size matrices: a morph moves its complex
 // every frame, and with matrices of dynamic size (at most 3) this was a
-// fifth of a frame of 2k39 model 1 -> 3 (perf).
+// large share of a frame.
 template <int D>
 void simplex_geometry(MixedCell& cell, const std::vector<Ball>& balls) {
   using Mat = Eigen::Matrix<double, D, D>;
@@ -343,8 +341,8 @@ struct SkinComplexBuilder {
   // ascending cell) taking its centre and size from there and its projector
   // from `from`. Copy-assigned, so that a complex moved before keeps its
   // allocations; not even copied when `out` holds `from`'s combinatorics
-  // already (a morph's frames): the copy of 2k39 model 1 -> 3's cells,
-  // cofaces and tuple map was about half of moving its complex (2.3 ms).
+  // already (a morph's frames): the copy of the cells, cofaces and tuple
+  // map was about half of moving a complex.
   static void moved(const SkinComplex& from, std::vector<Ball> balls, const std::vector<SkinComplex::KnownCell>& known,
                     SkinComplex& out) {
     if (balls.size() != from.balls_.size()) contract_error("with_balls: the number of balls differs from the complex's");
@@ -357,9 +355,8 @@ struct SkinComplexBuilder {
     if (out.combinatorics_ != from.combinatorics_ || out.cells_.size() != from.cells_.size()) out = from;
     out.balls_ = std::move(balls);
     // Each cell on its own, on every core: a morph moves the complex every
-    // frame, and serially this was a tenth of a frame (pept -> 3al1: 15 ms
-    // of 0.14 s; 1ubi -> 1hpv 120 ms). Every field of the geometry is
-    // written, so a cell's earlier frame leaves nothing behind.
+    // frame, and serially this was a tenth of a frame. Every field of the
+    // geometry is written, so a cell's earlier frame leaves nothing behind.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, out.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t c = r.begin(); c != r.end(); ++c) {
         out.cells_[c].degenerate = false;
@@ -399,7 +396,7 @@ struct SkinComplexBuilder {
     add_constraints_beyond_flat_cofaces(sc.cells_, sc.faces_, sc.face_offset_, sc.cofaces_, sc.coface_offset_);
     build_start_grid(sc);
     // The complex outlives everything the mesher allocates: give back the
-    // growth slack of its largest list (up to half of 27 MB on 3mht).
+    // growth slack of its largest list (up to half of that list).
     sc.cells_.shrink_to_fit();
     return sc;
   }

@@ -120,8 +120,8 @@ struct Solution {
 
 // A support holds at most 4 balls with affinely independent centres, and one
 // more enters before a step drops one: fixed-capacity matrices spare a heap
-// allocation per matrix per iteration (half the oracle's time went to malloc
-// and free on 3mht's 164,000 vertices).
+// allocation per matrix per iteration (with dynamic matrices, malloc and
+// free took much of the oracle's time).
 constexpr int kMaxSupport = 8;
 using SupportVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSupport + 1, 1>;
 using SupportMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxSupport + 1, kMaxSupport + 1>;

@@ -86,8 +86,7 @@ std::vector<TopologyEvent> critical_events(const std::vector<TopologyEvent>& eve
   // marginals are, docs/math.md section 4), so the pairs the oracle names
   // need not be one simplex's. Compared by pairs, and with every simplex of
   // such a cell an event of its own, the events' Euler changes missed the
-  // skin's in 5 of 49 steps of 0.02 on 2k39 model 1 -> 3 and 16 of 49 on
-  // pept -> 3al1 (against the static mesher's meshes); now in none.
+  // skin's in some steps (against the static mesher's meshes); now in none.
   std::map<BallSets, std::vector<double>> found;  // per overlay cell: its critical times
   std::vector<TopologyEvent> critical;
   for (const TopologyEvent& e : events) {

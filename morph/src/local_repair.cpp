@@ -101,10 +101,8 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
 // across a thin gap, the far side of a narrow neck) become context too.
 // Without them the Voronoi edge of a patch facet runs on across the gap, its
 // restricted point lies on the other sheet, and refinement meshes that sheet
-// a second time: `skinmesh morph` of 2k39 model 1 -> 3 in 100 frames
-// (Kabsch) tried 73 local repairs, and 7 failed so (4 changed the topology,
-// 3 "needed more than twice its own points"), each then remeshing the whole
-// frame; with them, none failed. Near: within twice the longest edge of the
+// a second time: the repair fails (a wrong topology, or too many points)
+// and the whole frame is remeshed. Near: within twice the longest edge of the
 // region's triangles, about the diameter of a patch facet's surface
 // Delaunay ball.
 void add_nearby_context(const SurfaceMesh& mesh, const std::vector<char>& region, std::vector<signed char>& role) {
@@ -122,8 +120,7 @@ void add_nearby_context(const SurfaceMesh& mesh, const std::vector<char>& region
     if (role[static_cast<size_t>(v)] == kNone) grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and one stretched triangle
-  // makes the reach long. On 1ubi -> 1hpv (t = 0.39 in 100 frames) the list
-  // took 805 MB, twice what the rest of the morph holds (heaptrack).
+  // makes the reach long, so the list could outgrow the rest of the morph.
   const auto context = static_cast<signed char>(PatchRole::context);
   for (size_t v = 0; v < role.size(); ++v) {
     if (role[v] == kNone || role[v] == context) continue;

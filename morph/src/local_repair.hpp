@@ -42,23 +42,17 @@ struct TopologyChange {
 };
 
 struct LocalRepairOptions {
-  // Rings of triangles around the failing ones. One ring: bench_morph 2k39
-  // model 1 -> 3 (100 frames, three runs alternating with two rings) 0.0308,
-  // 0.0311, 0.0319 against 0.0320, 0.0325, 0.0332 s a frame, the same frames
-  // remeshed whole (27 of 99); pept -> 3al1 alike (0.1099 against 0.1078).
-  // No ring: 0.0370.
+  // Rings of triangles around the failing ones that join the patch (a
+  // count; default 1): one ring mends as many frames as two, at less cost,
+  // and none mends fewer.
   int rings = 1;
   int attempts = 4;            // the patch grown around the seam's faults, at most this many times
   double crowded_below = 0.4;  // interior vertices this close (times the target length) are removed
   // A patch whose samples (with their context) pass this share of the
-  // frame's vertices is not tried: it is nearly the whole frame, which the
-  // whole-frame remesh does once, where a patch may be tried four times. On
-  // 1ubi -> 1hpv every patch took 90-99% of the vertices. 100 frames (a
-  // probe, 2026-11-25, a frame's seconds and peak memory): 1ubi -> 1hpv
-  // 0.865 s and 619 MB against 0.978 s and 897 MB without the bound; 3al1 ->
-  // 1ubi 0.287 against 0.298 s; pept -> 3al1 and 2k39 model 1 -> 3 within
-  // noise. (0.7: 1ubi -> 1hpv 0.843 s, 3al1 -> 1ubi 0.297; 0.3 cost 2k39
-  // 11%, whose patches of 30-50% succeed cheaply.)
+  // frame's vertices is not tried (a share, 0-1; default 0.9): it is nearly
+  // the whole frame, which the whole-frame remesh does once, where a patch
+  // may be tried `attempts` times. Lower would also refuse patches of a
+  // third to a half of the frame, which often succeed cheaply.
   double max_sample_share = 0.9;
   // Topology changes the patch must make (none: the topology must stay), and
   // the change of the Euler characteristic they add up to (the critical

@@ -36,10 +36,9 @@ bool takes_a_sphere(const TopologyEvent& e) { return (e.dim == 0 || e.dim == 3) 
 // (down by 2) and was `handled` (its component dropped, drop_vanished) is
 // left out. False when one vanishes that was not: the frame is remeshed
 // whole. (Such an event as a patch to remesh, like a neck, made the morph
-// slower: bench_morph c, 3al1 -> 1ubi 0.330 to 0.413 s a frame, 1ubi ->
-// 1hpv 0.927 to 1.431 s and 393 to 812 MB, the patches failing after their
-// cost.) The patch reaches 1 A plus twice the feature's size at `to` from
-// the event's apex, past the vertices transport left around it.
+// slower, the patches failing after their cost.) The patch reaches 1 A plus
+// twice the feature's size at `to` from the event's apex, past the vertices
+// transport left around it.
 bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
                           double to, const std::vector<char>& handled, detail::LocalRepairOptions& local) {
   for (size_t i = 0; i < events.size(); ++i) {
@@ -333,13 +332,10 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
   frame_.stats = stats;
   // While the frame is mended by edits or a patch, mostly on one core, the
   // next frame's complex is moved on the other into current_, which
-  // transport no longer needs: 2k39 model 1 -> 3 took 0.0093-0.0095 s a
-  // frame instead of 0.0101-0.0102 (a probe over 100 frames). It is waited
-  // for before a whole-frame remesh, which runs partly on both cores:
-  // overlapping that too saved 1-2% of a frame of 3al1 -> 1ubi and raised
-  // its peak memory from 175 to 208 MB (glibc's heap for the other
-  // thread). The cell list and balls are made on this thread for the same
-  // reason.
+  // transport no longer needs. It is waited for before a whole-frame
+  // remesh, which runs partly on both cores: overlapping that too saved
+  // little and raised the peak memory (glibc's heap for the other thread).
+  // The cell list and balls are made on this thread for the same reason.
   const bool ahead = next_t > t && next_t < 1 && stats.lost == 0 && !vanishing_left(t, moved.handled);
   std::vector<SkinComplex::KnownCell> known;
   std::vector<Ball> balls;
@@ -351,7 +347,7 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
   }
   mend_frame(next, t, moved, [&] { lookahead.wait(); });
   lookahead.wait();
-  std::swap(current_, spare_);  // a copy of the complex was 1% of a frame (perf, pept -> 3al1)
+  std::swap(current_, spare_);  // swapped, not copied: a copy of the complex costs a share of every frame
   spare_t_ = ahead ? next_t : -1;
   finish_frame(t, start);
   return frame_;
@@ -402,10 +398,9 @@ void Morph::mend_frame(const SkinComplex& next, double t, Transported& moved,
 // The overlay complex at t: middle_ moved to B(t), each overlay cell's
 // centre and size from its curves (eq. 17-18: z(t) affine, R2(t) quadratic)
 // and its directions from B(1/2). Recomputed from the balls instead, a cell
-// near t = 0 or 1 is a sliver and lost digits: on 2k39 model 1 -> 3 a frame
-// at t = 0.999 had a vertex 4.2e-9 A off the skin by the morph oracle and by
-// CGAL's skin sign, and the command refused t = 0.999 (1.27e-8 A); with the
-// curves, 1.2e-13 A (bench/morph_precision).
+// near t = 0 or 1 is a sliver and loses digits, enough to put a frame's
+// vertices off the skin by more than the 1e-8 A a frame is held to
+// (bench/morph_precision checks a frame against CGAL's skin sign).
 SkinComplex Morph::overlay_at(double t) const {
   SkinComplex out;
   overlay_at(t, out);

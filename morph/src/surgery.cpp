@@ -27,9 +27,9 @@ uint64_t edge_key(int from, int to) {
 }
 
 // The edge index is a flat hash map (robin-map-dev): a node-based
-// std::unordered_map allocated a node per directed edge, every frame (18,000
-// on 2k39), and its allocations and lookups were a fifth of the edits' time
-// (perf). The keys are mixed (splitmix64's finaliser): libstdc++ hashes an
+// std::unordered_map allocated a node per directed edge, every frame, and
+// its allocations and lookups were a large share of the edits' time. The
+// keys are mixed (splitmix64's finaliser): libstdc++ hashes an
 // integer to itself, and with these keys, whose low half is a vertex, the
 // flat map's probes ran long enough that it grew until allocation failed.
 struct EdgeKeyHash {

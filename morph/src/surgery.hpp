@@ -9,10 +9,8 @@
 // failing for the local repair (local_repair.hpp) or the frame's remesh.
 //
 // Why: a local repair builds a Delaunay triangulation of its patch with
-// context, about 2,000-4,000 points for a step of pept -> 3al1 at 2% of
-// the triangles failing, and CGAL inserts skin samples at about 4.5
-// microseconds a point here; a patch cost 20-70 ms, as much as remeshing
-// the whole frame (docs/morph.md, "Mending by edits").
+// its context, which costs about as much as remeshing the whole frame,
+// however few triangles fail (docs/morph.md, "Mending by edits").
 #pragma once
 
 #include "skinmesh/core/skin_complex.hpp"
@@ -42,9 +40,9 @@ struct SurgeryOptions {
   double thin_below = 0.5;
   // A thinning contraction refused in an earlier frame is tried again only
   // when its edge has shrunk by this share since, or after this many frames.
-  // Most short edges are refused frame after frame (2k39 model 1 -> 3: about
-  // 750 tried a frame, 93% refused, each judging up to a fan of triangles):
-  // they are short by design where the mesh was refined with room.
+  // Most short edges are refused frame after frame, each refusal judging a
+  // fan of triangles: they are short by design where the mesh was refined
+  // with room. A share (dimensionless) and a count of frames.
   double retry_shrink = 0.05;
   int retry_after_frames = 8;
 };

@@ -77,8 +77,8 @@ struct FacetEval {
 static_assert(sizeof(FacetEval) <= 80, "kept for every restricted facet: keep it small");
 
 // Lists of restricted facets. A deque: it grows without copying itself
-// (a vector's reallocation held two copies of the largest list at once, the
-// peak of the run: 42 + 26 MB on 3mht, heaptrack).
+// (a vector's reallocation held two copies of the largest list at once, and
+// that was the peak of the run).
 using FacetEvals = std::deque<FacetEval>;
 
 // A Voronoi edge dual to a Delaunay facet, from a to b along the facet's
@@ -109,7 +109,7 @@ struct FacetShape {
 
 // A bad facet in refinement's queue, with the cell it was evaluated from
 // when known: while that cell and its neighbour keep their stamps the facet
-// is found without CGAL's search (is_facet, 5% of the main thread on 3mht).
+// is found without CGAL's search (is_facet, a share of the serial thread).
 struct QueuedFacet {
   FacetEval eval;
   Cell_handle cell;  // null when not known (a pass's findings)
@@ -117,12 +117,12 @@ struct QueuedFacet {
 };
 
 // Where a batch of refinement found a restricted facet: the next global pass
-// takes these instead of every facet the batches made (3mht: 0.33 of 2.3
-// million), while both cells still stand. 24 bytes: a list of whole
-// evaluations raised 3mht's peak by 26 MB. The first kKeptBatchEvals
+// takes these instead of every facet the batches made (a small share of
+// them), while both cells still stand. 24 bytes: a list of whole
+// evaluations raised the peak memory. The first kKeptBatchEvals
 // evaluations of a pass are kept whole all the same (5 MB at most), so that
-// the pass need not evaluate them again: a morph frame's remesh finds about
-// 8,000 (pept -> 3al1), a mesh of 1ubi 115,000.
+// the pass need not evaluate them again: that covers all of a morph frame's
+// remesh, part of a large molecule's mesh.
 struct BatchFound {
   Cell_handle cell;  // FacetShape::cell and ::index
   unsigned stamp_c = 0, stamp_n = 0;
@@ -319,7 +319,7 @@ class Refiner {
   size_t batch_found_after_cleanup_ = 0;
   std::vector<Cell_handle> star_;    // cells made by the last insertion
   // Cells made by insert() since made_since_ (a refinement batch), with
-  // their stamps; recorded only while refine() runs (seeding made 8 MB of them).
+  // their stamps; recorded only while refine() runs (seeding makes many).
   std::vector<std::pair<Cell_handle, unsigned>> made_;
   unsigned made_since_ = 0;
   bool recording_made_ = false;

@@ -83,9 +83,8 @@ FacetShape Refiner::shape_of(const Facet& facet) const {
 // section 2 at l = e_i. A segment with both ends strictly inside that sphere
 // (a convex ball) lies in the body's interior and cannot cross the skin. The
 // balls tried are those of the facet's corners' mixed cells, where the
-// Voronoi edges deep inside an atom lie: a third of all evaluations
-// (4.8 of 14.7 million over a 101-frame morph of pept -> 3al1) end here
-// instead of walking the complex.
+// Voronoi edges deep inside an atom lie: many evaluations end here instead
+// of walking the complex.
 bool Refiner::inside_a_shrunk_ball(const DualEdge& edge, const std::array<Vertex_handle, 3>& corners) const {
   constexpr double kStrictly = 1 - 1e-9;  // far above the walk's rounding: its answer would be the same
   for (const Vertex_handle& v : corners) {
@@ -185,7 +184,7 @@ void Refiner::check_budget() const {
 // (kFreshCell; cells a removal made are stamped before any insertion): a walk
 // across their facets through v finds them, stamping each as it goes, which
 // is its own visited mark. (CGAL's incident_cells, with visited flags of its
-// own, was 8% of the main thread on 3mht.) Below dimension 3, CGAL's.
+// own, was a share of the serial thread.) Below dimension 3, CGAL's.
 void Refiner::stamp_star(Vertex_handle v) {
   star_.clear();
   if (dt_.dimension() < 3) {
@@ -267,8 +266,8 @@ void Refiner::insert_seeds(const std::vector<SkinPoint>& seeds, double spacing) 
 // the insertion order.
 void Refiner::insert_samples(const std::vector<SkinSample>& samples) {
   // Each sample checked on the skin (and polished onto it when off) in
-  // parallel: a morph frame remeshes from all its vertices (6,700 a frame on
-  // pept -> 3al1), and one by one this was a serial stretch of every frame.
+  // parallel: a morph frame remeshes from all its vertices, and one by one
+  // this was a serial stretch of every frame.
   std::vector<SkinSample> checked(samples.size());
   std::vector<char> on_skin(samples.size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, samples.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -331,7 +330,7 @@ void Refiner::keep_restricted(const std::vector<Facet>& facets, FacetEvals* rest
 // The finite facets of the cells insertions made (made_) that still stand,
 // each once: a facet between two such cells is listed from the one made
 // first. (Listing the cells around the new vertices again, as CGAL finds
-// them, cost 0.4 s of 3mht's refinement; insert() has them already.)
+// them, was a noticeable part of refinement; insert() has them already.)
 void Refiner::made_facets(std::vector<Facet>* facets) const {
   std::vector<Facet>& out = *facets;
   out.clear();
@@ -394,7 +393,7 @@ std::optional<Vertex_handle> Refiner::refine_one(QueuedFacet q, unsigned refine_
   // the same point; after one is inserted the other must not be (a
   // near-duplicate vertex would send refinement chasing it). So the nearest
   // vertex is looked up there, and in a patch (below); elsewhere the lookup
-  // (CGAL's walk over adjacent vertices, 6% of the main thread on 3mht)
+  // (CGAL's walk over adjacent vertices, a share of the serial thread)
   // never found one closer than half the radius on the shipped molecules.
   if (!e.well_conditioned || !roles_.empty()) {
     const Vertex_handle nearest = dt_.nearest_vertex(K::Point_3(e.center[0], e.center[1], e.center[2]), c);
@@ -444,11 +443,11 @@ uint32_t Refiner::tile_of(const Eigen::Vector3d& p) const {
 void Refiner::refine() {
   // Tile by tile along a Morton curve, and in a tile the largest ball first.
   // Within a tile this is the usual order; across tiles it keeps the
-  // triangulation's working set small (a 3mht lattice of 8 copies cost 1.5
-  // times as much per triangle as one copy when the whole queue was taken by
-  // size, 1.3 times tile by tile). Ties broken by the facet's vertex ids: CGAL's containers are
-  // ordered by memory addresses in places, and the order of refinement must
-  // not be.
+  // triangulation's working set small (taken by size alone, the queue
+  // jumps across the whole triangulation, and a large assembly costs more
+  // per triangle). Ties broken by the facet's vertex ids: CGAL's containers
+  // are ordered by memory addresses in places, and the order of refinement
+  // must not be.
   auto smaller = [](const QueuedFacet& x, const QueuedFacet& y) {
     const FacetEval &a = x.eval, &b = y.eval;
     if (a.tile != b.tile) return a.tile > b.tile;
@@ -471,9 +470,8 @@ void Refiner::refine() {
   // late, always at the same point, so the order of refinement does not
   // depend on timing. An entry whose cells the next batch replaced is
   // dropped when it comes up (refine_one): the new cells are evaluated.
-  // 1,024 insertions a batch: cells a later insertion of the same batch
-  // replaces are never evaluated (3mht refining: 256 3.60 s, 512 3.49 s,
-  // 1,024 3.41-3.45 s, 2,048 3.43 s, 4,096 3.59-3.60 s).
+  // 1,024 insertions a batch (the fastest of 256 to 4,096): cells a later
+  // insertion of the same batch replaces are never evaluated.
   constexpr size_t kBatch = 1024;
   std::vector<QueuedFacet> requeue;
   // Kept across batches: each is hundreds of kilobytes, which the allocator
@@ -600,7 +598,7 @@ bool Refiner::global_pass() {
   // facets are kept; any other unchanged facet was not restricted). Only the
   // facets of new cells are evaluated again, in chunks: about one facet in
   // seven is restricted, and an evaluation of every facet at once was half the
-  // peak memory (1ubi: 51 of 110 MB, heaptrack). Of the facets refinement's
+  // peak memory. Of the facets refinement's
   // batches evaluated, only the restricted ones they found that still stand
   // are taken, their evaluations as kept (BatchFound) or evaluated again:
   // the others were not restricted then and are the same now.
@@ -709,8 +707,8 @@ std::optional<uint32_t> Refiner::find_restricted(const FacetKey& ids) const {
 
 // Sorts by facet key: each key computed once (a key reads three vertices),
 // the keys sorted in parallel, the evaluations then permuted in place
-// (sorting the 80-byte evaluations with keys computed per comparison was
-// 0.11-0.23 s a pass on 3mht).
+// (sorting the 80-byte evaluations with keys computed per comparison was a
+// large part of a pass on large meshes).
 static void sort_by_key(FacetEvals& evals) {
   std::vector<std::pair<FacetKey, uint32_t>> order(evals.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, evals.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
@@ -784,9 +782,9 @@ std::vector<Vertex_handle> Refiner::star_checked_only(std::vector<Vertex_handle>
 // (the skin in this cell is a thin sliver, as along the creases of a skin
 // whose shrink factor is near 1), the skin point found by halving the way
 // from the sample towards it until it falls in this cell is used instead: a
-// point outside does not split this cell, and repeating it went on for 171
-// passes (pept at s = 0.995) or for ever (a 0.005 A void of 1ubi, whose
-// Voronoi vertices project onto the outer skin). Only when no such point
+// point outside does not split this cell, and repeating it went on for
+// many passes, or for ever (a tiny void whose Voronoi vertices project onto
+// the outer skin). Only when no such point
 // exists is an outside projection used.
 std::optional<Projection> Refiner::isolated_repair_point(Vertex_handle v) const {
   std::vector<Cell_handle> cells;
@@ -927,8 +925,8 @@ SurfaceMesh Refiner::extract(const FacetEvals& restricted, std::vector<long>* or
 
 // After refinement, the stars around the vertices it inserted are checked
 // here, not by another global pass: repairs come in short chains (a repair
-// point upsets a neighbour), and each global pass walks every facet (on 3mht,
-// 2.4 million). The facets around the region are evaluated again unless both
+// point upsets a neighbour), and each global pass walks every facet. The
+// facets around the region are evaluated again unless both
 // their cells are older than the last global pass.
 void Refiner::local_passes() {
   // After a large refinement the region is most of the mesh, and one global
@@ -937,7 +935,7 @@ void Refiner::local_passes() {
   // Stars a round could not check (it found bad triangles, and a star is
   // only judged once its triangles are good) are checked in the next one:
   // otherwise a broken star away from the next insertions waited for the
-  // next global pass (3mht: two more global passes, 0.3-0.4 s each).
+  // next global pass, which costs more.
   std::vector<Vertex_handle> unchecked;
   for (int round = 0; round < 50 && !recent_.empty() && recent_.size() <= most; ++round) {
     std::vector<Vertex_handle> region = std::move(unchecked);
@@ -990,7 +988,7 @@ void Refiner::refine_until_clean() {
     // (flat Delaunay tetrahedra of cocircular samples). Say so, never spin.
     // Repairs of vertex stars can chase each other on degenerate sets (the
     // exactly repeated balls of a morph's B(t)); real meshes settle in a
-    // few passes (3-10 measured on the shipped molecules).
+    // few passes.
     if (stats_.passes > 200)
       throw RefinementStopped{MeshingStatus::stalled, "refinement did not settle after 200 passes", stats_};
     if (dt_.number_of_vertices() == before)
@@ -1004,7 +1002,7 @@ SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
   const auto start = Clock::now();
   report("seeding", Report::now);
   // The seeds are found on the other cores while CGAL inserts the samples
-  // (serial): a morph frame's remesh waited 5 ms for them (pept -> 3al1).
+  // (serial), so that a remesh (a morph frame's) does not wait for them.
   std::vector<SkinPoint> seeds;
   tbb::task_group seeding;
   seeding.run([&] { seeds = critical_point_seeds(complex_); });

@@ -28,9 +28,8 @@ std::vector<SkinPoint> critical_point_seeds(const SkinComplex& complex) {
                                    .toRotationMatrix();
   for (auto& d : directions) d = turn * d.normalized();
   // Up to one point per cell and direction, found in parallel (every morph
-  // frame asks for them: 19,000 overlay cells on 2k39 model 1 -> 3, 41,000 on
-  // pept -> 3al1) and gathered in cell order, so the seeds are the same with
-  // any number of threads.
+  // frame asks for them, over every overlay cell) and gathered in cell
+  // order, so the seeds are the same with any number of threads.
   const auto& cells = complex.cells();
   std::vector<Eigen::Vector3d> found(4 * cells.size());
   std::vector<char> on_cell(4 * cells.size(), 0);

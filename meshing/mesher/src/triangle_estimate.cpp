@@ -145,7 +145,7 @@ namespace {
 constexpr double kTrianglesPerSizeArea = 1.3;
 constexpr double kTrianglesPerDistanceArea = 1.0;
 constexpr double kTrianglesPerCell = 1.7;
-constexpr double kBytesPerTriangle = 560;  // bench_estimate: 495-559 on meshes above 100,000 triangles
+constexpr double kBytesPerTriangle = 560;  // bytes; bench_estimate's peaks on meshes above 100,000 triangles, rounded up
 // Creases: where a hyperboloid patch bends more sharply than the sizes go
 // (radius of curvature under kCreaseRadius, far below the default size floor
 // of 0.05 A), the refinement for topology (one crossing per normal line,
@@ -153,9 +153,9 @@ constexpr double kBytesPerTriangle = 560;  // bench_estimate: 495-559 on meshes 
 // of waist radius a the smallest radius of curvature is rho = (1-s) a / s
 // (docs/math.md section 3), so its area over rho^2 counts its length over
 // rho, which grows as s / (1-s), whatever the size options. The constant is
-// fitted on pept, 3al1 and 1ubi at s = 0.99-0.9999 (measured over estimated
-// 0.85-1.33; 0.75 on pept at 0.999981, docs/benchmarks.md); kCreaseRadius is where the measured counts
-// begin to pass the area terms (s = 0.99, whose necks bend at about 0.01 A).
+// fitted on pept, 3al1 and 1ubi at s = 0.99-0.9999 (docs/benchmarks.md);
+// kCreaseRadius is where the measured counts begin to pass the area terms
+// (s = 0.99, whose necks bend at about 0.01 A).
 constexpr double kCreaseRadius = 0.01;  // Angstrom
 constexpr double kTrianglesPerCreaseArea = 0.086;
 

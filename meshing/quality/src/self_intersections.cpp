@@ -101,10 +101,9 @@ std::vector<std::vector<const Box*>> cut_into_slabs(const std::vector<Box>& boxe
 
 }  // namespace
 
-// CGAL's own parallel mode shuffles the boxes and was slower here (1hpv's
-// grading 0.41 to 0.56 s). Instead the slabs are checked each as a task of
-// its own (beside the oracle's, so the cores share them); pairs found in two
-// slabs are counted once.
+// CGAL's own parallel mode shuffles the boxes and was slower here. Instead
+// the slabs are checked each as a task of its own (beside the oracle's, so
+// the cores share them); pairs found in two slabs are counted once.
 long count_self_intersections(const SurfaceMesh& mesh) {
   for (const auto& t : mesh.triangles)
     if (degenerate(mesh, t)) return -1;
@@ -112,16 +111,13 @@ long count_self_intersections(const SurfaceMesh& mesh) {
   boxes.reserve(mesh.triangles.size());
   for (size_t f = 0; f < mesh.triangles.size(); ++f) boxes.push_back(box_of(mesh, static_cast<int>(f)));
   // Two slabs from 180,000 triangles, else one: each slab costs the box
-  // intersection more than its share (grading 1hpv beside the oracle: 8
-  // slabs of 20,000 0.323 s, 4 of 45,000 0.304 s, 2 0.297 s; 1ubi whole
-  // 0.098 s, in 3 slabs 0.102 s).
+  // intersection more than its share, and more slabs were slower.
   const size_t slabs = std::clamp<size_t>(boxes.size() / 90000, 1, 2);
   std::vector<std::vector<const Box*>> slab = cut_into_slabs(boxes, slabs);
   std::vector<std::vector<std::pair<int, int>>> found(slabs);
   tbb::parallel_for(size_t{0}, slabs, [&](size_t k) {
     // CGAL's cutoff below which a range is scanned instead of split: 2,000,
-    // as CGAL's own self-intersection test uses (boxes of 1ubi's mesh: 35 ms
-    // at 2,000, 47 ms at 300, 93 ms at 10).
+    // as CGAL's own self-intersection test uses (smaller ones were slower).
     CGAL::box_self_intersection_d<CGAL::Sequential_tag>(
         slab[k].begin(), slab[k].end(),
         [&](const Box* x, const Box* y) {

@@ -233,8 +233,7 @@ VolumeMeshResult failed(VolumeStatus status, std::string message) {
 // TetGen cannot split a tetrahedron whose refinement point would land on the
 // (unsplittable) surface, so a few next to it miss the bounds it is given. It
 // gets tighter ones, which leaves fewer such tetrahedra for improve_tet_mesh
-// (measured with 2.0/5 asked, 1ubi: TetGen at 2.0/5 left 11, 1 of them beyond
-// repair; at 1.6/10, none; at 1.2/10, 5, with twice the tetrahedra of 1.6/10).
+// (much tighter ones leave more again, among many more tetrahedra).
 // Below a ratio of about 1.2 or above about 18 degrees TetGen may not
 // terminate, so the tightened request stays inside those.
 std::string tetgen_switches(const VolumeOptions& options) {

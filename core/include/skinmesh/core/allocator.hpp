@@ -6,9 +6,9 @@ namespace skinmesh {
 
 // Large blocks (64 KiB and up) get their own pages and go back to the system
 // when freed. glibc otherwise raises this threshold as large blocks are freed,
-// after which they come from the heap and their pages stay resident: meshing
-// 3mht peaked at 262 MB resident for 199 MB of live heap (heaptrack), 207 MB
-// with this set, at the same speed. Does nothing on other C libraries.
+// after which they come from the heap and their pages stay resident, well
+// above the live heap; with this set the resident peak stays near it, at
+// the same speed. Does nothing on other C libraries.
 void return_large_blocks_to_system();
 
 }  // namespace skinmesh

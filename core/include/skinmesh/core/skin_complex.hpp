@@ -119,7 +119,7 @@ class SkinComplex {
   // its balls: a morph's overlay cell, whose directions are the same for
   // every t in (0,1), whose centre is affine and whose size is quadratic in
   // t (docs/math.md section 4). Near t = 0 or 1 such a cell is a sliver, and
-  // its geometry recomputed from its balls lost up to ~1e-8 A of the skin.
+  // its geometry recomputed from its balls loses digits.
   // Throws ContractError for a cell index out of range or cells not listed
   // in ascending order.
   struct KnownCell {
@@ -129,8 +129,8 @@ class SkinComplex {
   };
   SkinComplex with_balls(std::vector<Ball> balls, const std::vector<KnownCell>& known) const;
   // The same, written over `out`, whose storage is reused: a morph moves its
-  // complex every frame, and a fresh copy of pept -> 3al1's 41,000 cells took
-  // 6 of the 15 ms that moving it took. When `out` was itself moved from a
+  // complex every frame, and a fresh copy of its cells was a large part of
+  // moving it. When `out` was itself moved from a
   // complex of the same build (the morph's two frames in turn), only the
   // balls and the geometry are written: cells, faces, cofaces and the tuple
   // lookup are the same. `out` must not be this complex.

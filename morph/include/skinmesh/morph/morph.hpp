@@ -65,17 +65,13 @@ struct MorphOptions {
   // At a repair, a transported vertex nearer than this times the target
   // edge length to a neighbour along a mesh edge is removed (transport
   // crowds vertices where a patch shrinks; refinement puts back what the
-  // criteria need). Measured on 2k39 model 1 -> 3 in 10 steps: 0.2 let the
-  // vertex count double by t = 0.6, 0.4 kept it within 3,000-4,300. Over 100
-  // frames (2026-11-24, a frame's seconds and triangles): pept -> 3al1 0.4
-  // 0.128 s, 15,070; 0.5 0.124 s, 13,482; 0.6 0.127 s, 12,589. 2k39 model 1
-  // -> 3: 0.054 s, 6,861; 0.053 s, 6,143; 0.056 s, 5,754.
+  // criteria need). Dimensionless; default 0.5. Lower lets the vertex count
+  // grow frame after frame; higher leaves frames coarser, not faster.
   double crowded_below = 0.5;
   // Local repair is tried when at most this share of the triangles fails
-  // after transport; past it the patches cover much of the mesh and
-  // remeshing the whole frame from its vertices is faster (measured on 2k39
-  // model 1 -> 3 and pept -> 3al1, 30 frames: with 3-4% failing, local
-  // repair took 0.28 and 0.71 s a frame against 0.14 and 0.60 s). 0: never.
+  // after transport (a share, 0-1; default 0.01; 0: never); past it the
+  // patches cover much of the mesh and remeshing the whole frame from its
+  // vertices is faster.
   double local_repair_share = 0.01;
   // Failing triangles are first mended by edits of the mesh: an edge split
   // at a new skin point with Delaunay flips around it, a flip, or the
@@ -84,18 +80,13 @@ struct MorphOptions {
   bool edits = true;
   // Repairs (local and whole-frame) may refine to stricter criteria than
   // frames are accepted at, so that a repaired triangle has room to move
-  // before it fails again: the angle bound raised by the angle margin (at
-  // most 30 degrees), epsilon, the edge length cap and the tolerance times
-  // the size margin. The first frame's mesh takes its own size margin. Only
-  // that one pays: frames of a benign motion pass by transport alone after
-  // a first frame meshed with room (two balls moving apart: its first 2 of
-  // 18 frames; none with 1.0 there), while room at the repairs bought none
-  // (every later frame of the two balls was repaired either way) and made
-  // frames larger and slower. 100 frames, 2026-11-24, a frame's seconds,
-  // triangles and frames remeshed: pept -> 3al1 with +5 degrees and 0.85
-  // (the earlier defaults) 0.169 s, 20,361, 99 of 99; 0.85 alone 0.156 s,
-  // 18,649, 99; neither 0.127 s, 15,070, 99. 2k39 model 1 -> 3: 0.069 s,
-  // 69; 0.068 s, 74; 0.054 s, 86.
+  // before it fails again: the angle bound raised by the angle margin
+  // (degrees; the raised bound at most 30; default 0), epsilon, the edge
+  // length cap and the tolerance times the size margin (dimensionless;
+  // default 1: none). The first frame's mesh takes its own size margin
+  // (default 0.85). Only that one pays: after a first frame meshed with
+  // room, frames of a benign motion pass by transport alone, while room at
+  // the repairs did not spare repairs and made frames larger and slower.
   // Tangential relaxation after transport, before the triangles are judged
   // (relaxation.hpp; passes = 0: none).
   RelaxationOptions relaxation;
@@ -130,10 +121,10 @@ struct FrameStats {
   double max_kept_move = 0;    // largest move of a vertex whose id was kept, since the frame before (Angstrom)
   bool topology_certified = false;  // components, voids and Euler characteristic equal the skin's (skin_topology)
   std::string remeshed_because;     // why the last step remeshed whole was not mended locally ("" when none was)
-  // Where the frame's time went (seconds; docs/morph.md, "Where a frame's
-  // time goes"). The stages do not overlap; their sum falls short of
-  // `seconds` by the bookkeeping between them and by the wait for the
-  // complex moved ahead (advance_to's next_t).
+  // Where the frame's time went (seconds; `frames.jsonl` in docs/morph.md,
+  // "The output directory"). The stages do not overlap; their sum falls
+  // short of `seconds` by the bookkeeping between them and by the wait for
+  // the complex moved ahead (advance_to's next_t).
   double seconds = 0;            // the whole frame
   double seconds_complex = 0;    // the frame's complex moved to t (0 when moved ahead during the frame before)
   double seconds_transport = 0;  // every vertex transported or put on the new skin, vanished components dropped

@@ -22,10 +22,8 @@ struct RelaxationOptions {
   double weight = 0.5;    // share of the tangential way to the neighbours' centroid (dimensionless, (0,1])
   // A vertex whose tangential way to the centroid is shorter than this
   // times its mean distance to its neighbours stays where it is (no
-  // projection: most of a pass's cost). Dimensionless; 0: every vertex
-  // moves. Measured over 100 frames (a probe, 2026-11-25, a frame's
-  // seconds): 2k39 model 1 -> 3 0.0136-0.0149 with 0, 0.0107-0.0121 with
-  // 0.06, 0.0110-0.0111 with 0.1; pept -> 3al1 0.092, 0.083-0.087, 0.086-0.088.
+  // projection: most of a pass's cost). Dimensionless; default 0.06; 0:
+  // every vertex moves. Leaving settled vertices alone makes frames faster.
   double settled_below = 0.06;
 };
 

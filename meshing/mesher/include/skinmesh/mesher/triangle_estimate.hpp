@@ -52,7 +52,7 @@ SkinAreaProfile skin_area_profile(const SkinComplex& complex, const SkinAreaOpti
 // meshing"); at larger shrink factors the estimate can fall short, never over.
 inline constexpr double kTriangleEstimateSpread = 1.25;
 // Where the skin's creases make most of the estimate (a shrink factor near
-// 1), measured counts ran 0.75-1.33 times it (docs/benchmarks.md).
+// 1), measured counts spread wider around it (docs/benchmarks.md).
 inline constexpr double kCreaseEstimateSpread = 1.4;
 
 struct TriangleEstimate {
