@@ -389,11 +389,7 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
   const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
   if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, times); });
   report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
-  report["frames"] = times.size();
-  report["repaired_frames"] = result.repaired;
-  report["remeshed_frames"] = result.remeshed;
-  report["full_rebuilds"] = result.rebuilt;
-  report["repairs"] = result.repairs;
+  result.counts.into(report);
   report["min_ids_kept"] = result.min_ids_kept;
   report["max_kept_move"] = result.max_kept_move;
   report["seconds"] = seconds_since(start);
@@ -403,8 +399,7 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
   dir.keep();
   if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet)
-    std::cout << o.directory << ": " << times.size() << " frames, matched atoms (" << pairing.why << "), "
-              << result.remeshed << " remeshed whole, " << result.rebuilt << " rebuilt from scratch, ids kept "
+    std::cout << o.directory << ": " << result.counts.text() << ", matched atoms (" << pairing.why << "), ids kept "
               << result.min_ids_kept * 100 << "% or more a frame, " << report["seconds"].get<double>() << " s\n";
   return ExitCode::ok;
 }
@@ -472,7 +467,7 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   Morph morph = prepare_morph(sides.source_balls, sides.target_balls, times.front(), options);
   const FrameReference reference{oracle, morph, sides.source_balls, sides.target_balls, o.molecule.shrink};
   std::ostringstream lines;
-  long repairs = 0, rebuilds = 0, repaired = 0;
+  FrameCounts counts;
   for (size_t k = 0; k < times.size(); ++k) {
     const MorphFrame& f =
         k == 0 ? morph.frame() : morph.advance_to(times[k], k + 1 < times.size() ? times[k + 1] : -1);
@@ -486,10 +481,8 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
     }
     stage_frame(outputs, dir, k, morph, o.formats);
     lines << json_text(line, JsonLayout::one_line) << "\n";
-    repairs += f.stats.repairs;
-    rebuilds += k > 0 && f.stats.full_rebuild;
-    repaired += f.stats.repaired;
-    if (progress) print_progress(k + 1, times.size(), f.stats, repairs, seconds_since(start));
+    counts.add(line);
+    if (progress) print_progress(k + 1, times.size(), f.stats, counts.repairs, seconds_since(start));
   }
   if (progress) std::cerr << "\n";
   json report = morph_json(o, sides, morph, times, options);
@@ -503,10 +496,7 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
   if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, times); });
   report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
-  report["frames"] = times.size();
-  report["repaired_frames"] = repaired;
-  report["full_rebuilds"] = rebuilds;
-  report["repairs"] = repairs;
+  counts.into(report);
   report["seconds"] = seconds_since(start);
   outputs.add(dir.file("frames.jsonl"), [&](std::ostream& out) { out << lines.str(); });
   outputs.add(dir.file("morph.json"), [&](std::ostream& out) { out << json_text(report) << "\n"; });
@@ -514,8 +504,7 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   dir.keep();
   if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet)
-    std::cout << o.directory << ": " << times.size() << " frames (" << repaired << " repaired, " << rebuilds
-              << " rebuilt from scratch), alignment " << alignment_method_name(sides.alignment.used) << ", "
+    std::cout << o.directory << ": " << counts.text() << ", alignment " << alignment_method_name(sides.alignment.used) << ", "
               << morph.events().size() << " topology events, " << report["seconds"].get<double>() << " s\n";
   return ExitCode::ok;
 }

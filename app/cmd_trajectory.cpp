@@ -185,13 +185,10 @@ ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global)
                  {"min_angle", run.options.frames.min_angle},
                  {"first_frame_min_angle", run.options.first.min_angle},
                  {"max_step", run.options.max_step},
-                 {"frames", run.times.size()},
-                 {"repaired_frames", result.repaired},
-                 {"remeshed_frames", result.remeshed},
-                 {"full_rebuilds", result.rebuilt},
                  {"min_ids_kept", result.min_ids_kept},
                  {"max_kept_move", result.max_kept_move},
                  {"seconds", seconds_since(start)}};
+  result.counts.into(report);
   const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
   if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, run.times); });
   report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
@@ -201,8 +198,8 @@ ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global)
   dir.keep();
   if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet)
-    std::cout << o.directory << ": " << run.times.size() << " frames through " << models.size() << " models, "
-              << result.remeshed << " remeshed whole, ids kept " << result.min_ids_kept * 100
+    std::cout << o.directory << ": " << result.counts.text() << " through " << models.size() << " models, ids kept "
+              << result.min_ids_kept * 100
               << "% or more a frame, " << report["seconds"].get<double>() << " s\n";
   return ExitCode::ok;
 }

@@ -55,6 +55,28 @@ void OutputDirectory::keep() {
   removed_on_interrupt_.clear();
 }
 
+void FrameCounts::add(const nlohmann::json& line) {
+  const auto flag = [&](const char* key) { return line.contains(key) && line[key].is_boolean() && line[key].get<bool>(); };
+  ++frames;
+  from_scratch += flag("full_rebuild");
+  repaired += flag("repaired");
+  remeshed += flag("remeshed");
+  repairs += line.value("repairs", 0L);
+}
+
+std::string FrameCounts::text() const {
+  return std::to_string(frames) + " frames (" + std::to_string(from_scratch) + " meshed from scratch, " +
+         std::to_string(repaired) + " repaired, " + std::to_string(remeshed) + " remeshed whole)";
+}
+
+void FrameCounts::into(nlohmann::json& report) const {
+  report["frames"] = frames;
+  report["full_rebuilds"] = from_scratch;
+  report["repaired_frames"] = repaired;
+  report["remeshed_frames"] = remeshed;
+  report["repairs"] = repairs;
+}
+
 std::string frame_name(size_t k, const std::string& format) {
   char name[64];
   std::snprintf(name, sizeof name, "frame_%04zu.%s", k, format.c_str());
@@ -248,15 +270,13 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs
     }
     stage_moving_frame(outputs, dir, pending, run);
     lines << json_text(line, JsonLayout::one_line) << "\n";
-    result.repairs += st.repairs;
+    result.counts.add(line);
     if (pending.index > 0) {
-      result.repaired += st.repaired;
-      result.remeshed += st.remeshed;
-      result.rebuilt += st.full_rebuild;
       result.min_ids_kept = std::min(result.min_ids_kept, st.ids_kept);
       result.max_kept_move = std::max(result.max_kept_move, st.max_kept_move);
     }
-    if (run.progress) print_progress(pending.index + 1, run.times.size(), st, result.repairs, seconds_since(start));
+    if (run.progress)
+      print_progress(pending.index + 1, run.times.size(), st, result.counts.repairs, seconds_since(start));
     return true;
   };
   for (size_t k = 0; k < run.times.size(); ++k) {

@@ -79,11 +79,24 @@ struct MovingFrames {
   bool progress = false;             // a progress line on stderr
 };
 
+// The frames as frames.jsonl describes them, counted from its lines, so that
+// the terminal's summary, the report and the file agree.
+struct FrameCounts {
+  long frames = 0;
+  long from_scratch = 0;  // `full_rebuild`: the first frame, and any later one meshed anew
+  long repaired = 0;      // `repaired`
+  long remeshed = 0;      // `remeshed` (moving atoms): remeshed whole from the frame's vertices
+  long repairs = 0;       // the sum of `repairs` (refinement insertions)
+  void add(const nlohmann::json& line);
+  std::string text() const;  // "21 frames (1 meshed from scratch, 18 repaired, 2 remeshed whole)"
+  void into(nlohmann::json& report) const;  // frames, full_rebuilds, repaired_frames, remeshed_frames, repairs
+};
+
 struct MovingFramesResult {
   bool holds = false;           // every frame passed its checks (otherwise nothing is staged)
   nlohmann::json failed_frame;  // the frame that did not, as its frames.jsonl line
   size_t failed_index = 0;
-  long repaired = 0, remeshed = 0, rebuilt = 0, repairs = 0;
+  FrameCounts counts;
   double min_ids_kept = 1, max_kept_move = 0;  // over the frames after the first
 };
 

@@ -462,8 +462,11 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   // frames.jsonl: one object per frame with the fields a user plots.
   std::ifstream jsonl(dir + "/frames.jsonl");
   int frames = 0;
+  long from_scratch = 0, repaired = 0;
   while (std::getline(jsonl, line)) {
     const auto j = nlohmann::json::parse(line);
+    from_scratch += j.value("full_rebuild", false);
+    repaired += j.value("repaired", false);
     for (const char* key : {"t", "file", "vertices", "triangles", "min_angle", "share_below_bound", "moved",
                             "relocated", "inserted", "removed", "repairs", "full_rebuild", "max_onsurf_error",
                             "oracle_uncertified", "components", "euler", "seconds"})
@@ -489,6 +492,12 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   const auto m = nlohmann::json::parse(morph_json);
   CHECK(m["alignment"]["method"] == "kabsch");
   CHECK(m["alignment"]["matched_atoms"] == 78);
+  // The terminal's summary, morph.json and frames.jsonl count the frames alike.
+  CHECK(from_scratch >= 1);  // the first frame
+  CHECK(m["full_rebuilds"] == from_scratch);
+  CHECK(m["repaired_frames"] == repaired);
+  CHECK(r.output.find("4 frames (" + std::to_string(from_scratch) + " meshed from scratch, " + std::to_string(repaired) +
+                      " repaired") != std::string::npos);
   CHECK(m["frame_times"].size() == 4);
   // The source's balls read back bit for bit from source.xyzr.
   skinmesh::ReadOptions model1;
