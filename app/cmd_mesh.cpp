@@ -147,9 +147,10 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
 
   MeshingOptions meshing = o.meshing;
   meshing.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
-  if (progress) meshing.progress = meshing_progress_line();
+  const auto line = std::make_shared<ProgressLine>(progress);
+  if (progress) meshing.progress = meshing_progress_line(line);
   const SkinMeshResult result = mesh_skin(complex, meshing);
-  if (progress) std::cerr << "\r" << std::string(70, ' ') << "\r";
+  line->finish();
   if (result.status == MeshingStatus::empty_skin) input_error(o.molecule.path, 0, result.message);
   if (result.status != MeshingStatus::ok) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": " << result.message << "\n";

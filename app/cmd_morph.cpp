@@ -4,6 +4,7 @@
 // is written, into a self-describing directory (docs/morph.md).
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "meshing_feedback.hpp"
 #include "morph_frames.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
@@ -353,13 +354,13 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
   run.options.max_step = o.max_step;
   run.formats = o.formats;
   run.self_intersections = !o.no_self_intersections;
-  run.progress = progress;
+  if (progress) run.progress = std::make_shared<ProgressLine>(true);
   OutputDirectory dir(o.directory);
   OutputSet outputs;
   std::ostringstream lines;
   const MovingFramesResult result = run_moving_frames(run, outputs, dir, lines);
   if (!result.holds) {
-    if (progress) std::cerr << "\n";
+    if (run.progress) run.progress->finish();
     std::cerr << "skinmesh: error: frame " << result.failed_index << " (t = " << times[result.failed_index]
               << ") fails a guarantee; nothing written\n"
               << json_text(result.failed_frame) << "\n";
@@ -463,8 +464,14 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
   if (pairing.matched) return run_matched_morph(o, global, sides, times, pairing, start);
   OutputDirectory dir(o.directory);
   OutputSet outputs;
+  const auto shown = std::make_shared<ProgressLine>(progress);
+  shown->note("preparing the morph: the live pairs, the complex of B(1/2), its topology events, the first frame");
+  MorphOptions prepared = options;
+  if (progress) prepared.first.progress = meshing_progress_line(shown);
   const MorphOracle oracle(sides.source_balls, sides.target_balls, o.molecule.shrink);
-  Morph morph = prepare_morph(sides.source_balls, sides.target_balls, times.front(), options);
+  Morph morph = prepare_morph(sides.source_balls, sides.target_balls, times.front(), prepared);
+  shown->finish();
+  PaceEstimate pace(times.size());
   const FrameReference reference{oracle, morph, sides.source_balls, sides.target_balls, o.molecule.shrink};
   std::ostringstream lines;
   FrameCounts counts;
@@ -474,7 +481,7 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
     const FrameCheck check = check_frame(f.mesh, reference, times[k], options.frames.min_angle, !o.no_self_intersections);
     json line = blend_frame_json(f.stats, check, frame_name(k, o.formats.front()));
     if (!check.holds) {
-      if (progress) std::cerr << "\n";
+      shown->finish();
       std::cerr << "skinmesh: error: frame " << k << " (t = " << times[k] << ") fails a guarantee; nothing written\n"
                 << json_text(line) << "\n";
       return ExitCode::not_met;
@@ -482,9 +489,10 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
     stage_frame(outputs, dir, k, morph, o.formats);
     lines << json_text(line, JsonLayout::one_line) << "\n";
     counts.add(line);
-    if (progress) print_progress(k + 1, times.size(), f.stats, counts.repairs, seconds_since(start));
+    pace.done_one();
+    print_progress(*shown, pace, times.size(), f.stats, counts.repairs);
   }
-  if (progress) std::cerr << "\n";
+  shown->finish();
   json report = morph_json(o, sides, morph, times, options);
   report["skinmesh_version"] = version_text();
   report["command_line"] = global.command_line;

@@ -152,7 +152,7 @@ ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global)
   run.options.first.min_angle = std::max(30.0, angle);
   run.formats = o.formats;
   run.self_intersections = !o.no_self_intersections;
-  run.progress = progress;
+  if (progress) run.progress = std::make_shared<ProgressLine>(true);
   if (progress)
     std::cerr << "skinmesh: " << models.size() << " models of " << all.size() << ", " << keys.front().size()
               << " atoms each, " << run.times.size() << " frames\n";
@@ -161,6 +161,7 @@ ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global)
   std::ostringstream lines;
   const MovingFramesResult result = run_moving_frames(run, outputs, dir, lines);
   if (!result.holds) {
+    if (run.progress) run.progress->finish();
     std::cerr << "skinmesh: error: frame " << result.failed_index << " fails a guarantee; nothing written\n"
               << json_text(result.failed_frame) << "\n";
     return ExitCode::not_met;

@@ -142,9 +142,10 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   const SkinComplex complex = build_skin_complex(balls, {o.molecule.shrink});
   MeshingOptions meshing = o.meshing;
   meshing.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
-  if (progress) meshing.progress = meshing_progress_line();
+  const auto line = std::make_shared<ProgressLine>(progress);
+  if (progress) meshing.progress = meshing_progress_line(line);
   const SkinMeshResult surface = mesh_skin(complex, meshing);
-  if (progress) std::cerr << "\r" << std::string(70, ' ') << "\r";
+  line->finish();
   if (surface.status == MeshingStatus::empty_skin) input_error(o.molecule.path, 0, surface.message);
   if (surface.status != MeshingStatus::ok) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": " << surface.message << "\n";

@@ -9,24 +9,24 @@
 
 namespace skinmesh::app {
 
-std::function<void(const MeshingProgress&)> meshing_progress_line() {
+std::function<void(const MeshingProgress&)> meshing_progress_line(std::shared_ptr<ProgressLine> line) {
   const auto start = Clock::now();
-  return [start](const MeshingProgress& p) {
+  return [start, line](const MeshingProgress& p) {
     const double elapsed = seconds_since(start);
+    char text[160];
     if (p.expected_vertices > 0) {
       // Refinement inserts points at a roughly even pace; the estimate can be
       // short (docs/benchmarks.md), so past it the line says nothing about time.
       const double done = std::min(0.99, static_cast<double>(p.vertices) / p.expected_vertices);
       if (done < 0.99 && done > 0.02)
-        std::fprintf(stderr, "\rskinmesh: %-9s %9ld vertices, %3.0f%%, about %.0f s left   ", p.stage, p.vertices,
-                     100 * done, elapsed * (1 - done) / done);
+        std::snprintf(text, sizeof text, "%-9s %9ld vertices, %3.0f%%, about %.0f s left", p.stage, p.vertices,
+                      100 * done, elapsed * (1 - done) / done);
       else
-        std::fprintf(stderr, "\rskinmesh: %-9s %9ld vertices, %3.0f%%                  ", p.stage, p.vertices,
-                     100 * done);
+        std::snprintf(text, sizeof text, "%-9s %9ld vertices, %3.0f%%", p.stage, p.vertices, 100 * done);
     } else {
-      std::fprintf(stderr, "\rskinmesh: %-9s %9ld vertices, %8ld pending", p.stage, p.vertices, p.pending);
+      std::snprintf(text, sizeof text, "%-9s %9ld vertices, %8ld pending", p.stage, p.vertices, p.pending);
     }
-    std::fflush(stderr);
+    line->update(text);
   };
 }
 

@@ -2,15 +2,19 @@
 // shared by `mesh` and `volume`.
 #pragma once
 
+#include "progress.hpp"
+
 #include "skinmesh/mesher/skin_mesher.hpp"
+
+#include <memory>
 
 #include <string>
 
 namespace skinmesh::app {
 
-// A progress line rewritten in place: stage, vertices, and (when the mesher
+// The mesher's progress on `line`: stage, vertices, and (when the mesher
 // has an estimate) the share done and the time left at the pace so far.
-std::function<void(const MeshingProgress&)> meshing_progress_line();
+std::function<void(const MeshingProgress&)> meshing_progress_line(std::shared_ptr<ProgressLine> line);
 
 // For a job over its budget: the command-line options that would fit it
 // (from SkinMeshResult::fitting_sizes), or the general advice. A command with

@@ -1,5 +1,7 @@
 #include "morph_frames.hpp"
 
+#include "meshing_feedback.hpp"
+
 #include "output_file.hpp"
 #include "quality_report.hpp"
 
@@ -146,11 +148,12 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"seconds_repair", s.seconds_repair}};
 }
 
-void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed) {
-  const double left = done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0.0;
-  std::fprintf(stderr, "\rskinmesh: frame %zu/%zu  t = %.4f  %ld vertices  %ld repairs  %.0f s left   ", done, total,
-               s.t, s.vertices, repairs, left);
-  std::fflush(stderr);
+void print_progress(ProgressLine& line, const PaceEstimate& pace, size_t total, const FrameStats& s, long repairs) {
+  char text[160];
+  const double left = pace.seconds_left();
+  std::snprintf(text, sizeof text, "frame %zu/%zu  t = %.4f  %ld vertices  %ld repairs  %.0f s left", pace.done(), total,
+                s.t, s.vertices, repairs, std::max(left, 0.0));
+  line.update(text, pace.done() == total);
 }
 
 namespace {
@@ -252,9 +255,14 @@ void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, const Ma
 // vertex, the exact self-intersection test) runs beside them.
 MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs, const OutputDirectory& dir,
                                      std::ostream& lines) {
-  const auto start = Clock::now();
   MovingFramesResult result;
-  MovingBalls moving(run.balls_of(0), run.options, run.times.front());
+  MovingOptions options = run.options;
+  if (run.progress) {
+    run.progress->note("meshing the first frame");
+    options.first.progress = meshing_progress_line(run.progress);
+  }
+  PaceEstimate pace(run.times.size());
+  MovingBalls moving(run.balls_of(0), options, run.times.front());
   MadeFrame pending;
   FrameCheck check;
   tbb::task_group checking;
@@ -275,8 +283,8 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs
       result.min_ids_kept = std::min(result.min_ids_kept, st.ids_kept);
       result.max_kept_move = std::max(result.max_kept_move, st.max_kept_move);
     }
-    if (run.progress)
-      print_progress(pending.index + 1, run.times.size(), st, result.counts.repairs, seconds_since(start));
+    pace.done_one();
+    if (run.progress) print_progress(*run.progress, pace, run.times.size(), st, result.counts.repairs);
     return true;
   };
   for (size_t k = 0; k < run.times.size(); ++k) {
@@ -287,7 +295,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs
     checking.run([&] { check = check_moving_frame(pending, run.options.frames.min_angle, run.self_intersections); });
   }
   if (!finish()) return result;
-  if (run.progress) std::fprintf(stderr, "\n");
+  if (run.progress) run.progress->finish();
   result.holds = true;
   return result;
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "output_file.hpp"
+#include "progress.hpp"
 
 #include "skinmesh/core/balls.hpp"
 #include "skinmesh/core/skin_topology.hpp"
@@ -46,9 +47,9 @@ std::string frame_name(size_t k, const std::string& format);  // frame_0007.ply
 void write_pvd(std::ostream& out, const std::vector<double>& times);
 // The share of the triangles whose smallest angle is under the bound (degrees).
 double share_below(const SurfaceMesh& mesh, double bound_degrees);
-// One line on the terminal, rewritten: frames done, vertices, repairs and
-// the time left at the pace so far.
-void print_progress(size_t done, size_t total, const FrameStats& s, long repairs, double elapsed);
+// A frame done on `line`: frames done, t, vertices, repairs and the time
+// left at the pace of the latest frames (`pace` has counted this one).
+void print_progress(ProgressLine& line, const PaceEstimate& pace, size_t total, const FrameStats& s, long repairs);
 
 // What is measured of every frame before it is written, either kind of morph.
 struct FrameCheck {
@@ -76,7 +77,7 @@ struct MovingFrames {
   MovingOptions options;
   std::vector<std::string> formats;  // mesh formats per frame
   bool self_intersections = true;    // the exact check on every frame
-  bool progress = false;             // a progress line on stderr
+  std::shared_ptr<ProgressLine> progress;  // null: none
 };
 
 // The frames as frames.jsonl describes them, counted from its lines, so that

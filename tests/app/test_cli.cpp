@@ -449,6 +449,11 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   const Run r = run("morph " + file + " " + file + " --source-model 1 --target-model 3 --pairs all --frames 4 -o " + dir);
   INFO(r.output);
   REQUIRE(r.code == 0);
+  // stderr is a pipe here, as in a log: plain lines, the preparation shown,
+  // the last frame's line always there.
+  CHECK(r.output.find('\r') == std::string::npos);
+  CHECK(r.output.find("skinmesh: preparing the morph") != std::string::npos);
+  CHECK(r.output.find("skinmesh: frame 4/4") != std::string::npos);
   for (int k = 0; k < 4; ++k)
     for (const char* ext : {"ply", "vtp"}) {
       std::ifstream frame(dir + "/frame_000" + std::to_string(k) + "." + ext);
