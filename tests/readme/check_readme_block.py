@@ -91,8 +91,11 @@ def main():
     if [comparable(l) for l in printed] == [comparable(l) for l in expected]:
         print("the README's block is what the main job prints (%d lines)" % len(printed))
         return 0
+    # In the diff a time line that agrees but for its numbers is shown as the README's.
+    same_but_numbers = {comparable(l): l for l in expected if l.strip().startswith("time:")}
+    shown = [same_but_numbers.get(comparable(l), l) if l.strip().startswith("time:") else l for l in printed]
     print("the main job's output differs from the README's block (the time line's numbers are not compared):")
-    sys.stdout.writelines(difflib.unified_diff([l + "\n" for l in expected], [l + "\n" for l in printed],
+    sys.stdout.writelines(difflib.unified_diff([l + "\n" for l in expected], [l + "\n" for l in shown],
                                                "README.md", "printed"))
     return 1
 
