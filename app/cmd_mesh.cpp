@@ -32,6 +32,7 @@ struct MeshCommandOptions {
   double max_memory_gb = 0;  // 0: the memory available when the command starts
   bool single_precision = false;
   bool no_self_intersections = false;
+  bool outer_only = false;  // drop the components another encloses (cavities, islands in them)
 };
 
 // The patch type and the atom that owns each vertex.
@@ -48,6 +49,9 @@ void add_mesh_options(CLI::App& cmd, MeshCommandOptions& o) {
   add_molecule_options(cmd, o.molecule);
   cmd.add_option("--output,-o", o.output, "mesh file: .ply .off .obj .stl .vtp .msh (Gmsh), or .vert (MSMS .vert + .face)")
       ->required();
+  cmd.add_flag("--outer-only", o.outer_only,
+               "keep only the outer surface: drop every component another encloses (cavities, and anything inside "
+               "them), as a boundary-element solver of the exterior wants");
   cmd.add_option("--report", o.report, "write the quality report as JSON");
   cmd.add_option("--svg", o.svg, "write a histogram of the smallest angles as SVG");
   cmd.add_option("--min-angle", o.meshing.min_angle, "smallest angle of every triangle, degrees (at most 30)")
@@ -123,6 +127,9 @@ void write_outputs(const MeshCommandOptions& o, MeshFormat format, const SkinCom
 void print_summary(const MeshCommandOptions& o, const GuaranteeReport& g, const json& report) {
   print_quality_summary(std::cout, o.output, g.quality);
   const json& seconds = report["seconds"];
+  const json& area = report["skin_area"];
+  std::cout << "  skin area:   " << area["skin"].get<double>() << " A^2 (+- " << area["uncertainty"].get<double>()
+            << "); the triangles' is " << 100 * area["mesh_relative_error"].get<double>() << "% off\n";
   std::cout << "  on-surface error: max " << g.surface_error.max << " A, mean " << g.surface_error.mean
             << " A (oracle)\n"
             << "  guarantees:  angle >= " << o.meshing.min_angle << " deg, vertices on the skin, closed "
@@ -158,12 +165,16 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
     return ExitCode::not_met;
   }
   if (progress) std::cerr << "skinmesh: meshed; grading\n";
+  SurfaceMesh outer;
+  if (o.outer_only) outer = outer_surface(result.mesh);
+  const SurfaceMesh& mesh = o.outer_only ? outer : result.mesh;
 
   const auto grade_start = Clock::now();
   GuaranteeOptions bounds;
   bounds.min_angle = meshing.min_angle;
   bounds.self_intersections = o.no_self_intersections ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
-  const GuaranteeReport g = check_guarantees(result.mesh, balls, o.molecule.shrink, bounds);
+  const GuaranteeReport g = check_guarantees(mesh, balls, o.molecule.shrink, bounds);
+  const SkinArea skin = skin_area(complex, mesh);
   const double seconds_grading = seconds_since(grade_start);
 
   const MeshingStats& s = result.stats;
@@ -177,6 +188,11 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
                  {"format", mesh_format_name(format)},
                  {"options", options_json(meshing)},
                  {"quality", to_json(g.quality)},
+                 {"outer_only", o.outer_only},
+                 {"components_dropped", o.outer_only ? surface_components(result.mesh).enclosed_volume.size() -
+                                                           surface_components(mesh).enclosed_volume.size()
+                                                     : 0},
+                 {"skin_area", skin_area_json(skin, g.quality.area)},
                  {"on_surface_error", to_json(g.surface_error)},
                  {"guarantees", guarantees_json(g)},
                  {"refinement", refinement_json(s)},
@@ -196,7 +212,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
               << "\n";
     return ExitCode::not_met;
   }
-  write_outputs(o, format, complex, result.mesh, g.quality, report, start);
+  write_outputs(o, format, complex, mesh, g.quality, report, start);
   if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet) print_summary(o, g, report);
   return ExitCode::ok;

@@ -166,6 +166,14 @@ void print_tet_quality(std::ostream& out, const TetQuality& q) {
       << " away from the surface); " << q.inverted << " inverted\n";
 }
 
+nlohmann::json skin_area_json(const SkinArea& skin, double mesh_area) {
+  return {{"skin", skin.area},
+          {"uncertainty", skin.uncertainty},
+          {"mesh", mesh_area},
+          {"mesh_relative_error", skin.area > 0 ? (mesh_area - skin.area) / skin.area : 0.0},
+          {"converged", skin.converged}};
+}
+
 nlohmann::json options_json(const MeshingOptions& m) {
   return {{"min_angle_deg", m.min_angle},
           {"epsilon", m.edge_length > 0 ? nlohmann::json(nullptr) : nlohmann::json(m.sizing.epsilon)},

@@ -8,6 +8,7 @@
 #include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 #include "skinmesh/quality/on_surface_error.hpp"
+#include "skinmesh/quality/skin_area.hpp"
 #include "skinmesh/quality/tet_quality.hpp"
 
 #include <nlohmann/json.hpp>
@@ -30,6 +31,10 @@ nlohmann::json to_json(const MeshQuality& q);
 nlohmann::json to_json(const SurfaceError& e);
 // Each guarantee true or false (no_self_intersections null when not checked).
 nlohmann::json guarantees_json(const GuaranteeReport& g);
+
+// The skin's own area beside the triangles' (skin_area.hpp): {"skin",
+// "uncertainty", "mesh", "mesh_relative_error", "converged"}.
+nlohmann::json skin_area_json(const SkinArea& skin, double mesh_area);
 
 // The mesher's options and its refinement counts as `skinmesh mesh --report` writes them.
 nlohmann::json options_json(const MeshingOptions& m);

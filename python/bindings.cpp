@@ -266,11 +266,14 @@ MeshResult mesh(const py::object& source, const py::kwargs& kwargs) {
   BallSource in = balls_from(source, o, shrink);
   MeshingOptions m = meshing_options(o, 30.0);
   const bool self_intersections = !o.get<bool>("no_self_intersections", false);
+  const bool outer_only = o.get<bool>("outer_only", false);
   const py::object progress = o.get<py::object>("progress", py::none());
   o.finish();
   m.progress = progress_from(progress);
   SkinMeshResult made;
   GuaranteeReport g;
+  SkinArea area;
+  size_t dropped = 0;
   std::vector<int> atom, patch;
   nlohmann::json seconds;
   {
@@ -280,11 +283,17 @@ MeshResult mesh(const py::object& source, const py::kwargs& kwargs) {
     seconds["complex"] = seconds_since(start);
     made = mesh_skin(complex, m);
     seconds["meshing"] = made.stats.seconds_total;
+    if (made.status == MeshingStatus::ok && outer_only) {
+      const size_t before = surface_components(made.mesh).enclosed_volume.size();
+      made.mesh = outer_surface(made.mesh);
+      dropped = before - surface_components(made.mesh).enclosed_volume.size();
+    }
     if (made.status == MeshingStatus::ok) {
       GuaranteeOptions bounds;
       bounds.min_angle = m.min_angle;
       bounds.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
       g = check_guarantees(made.mesh, in.balls, shrink, bounds);
+      area = skin_area(complex, made.mesh);
       for (size_t v = 0; v < made.mesh.vertices.size(); ++v) {
         patch.push_back(complex.cell(made.mesh.cells[v]).dim);
         atom.push_back(complex.owning_ball(made.mesh.vertices[v], made.mesh.cells[v]));
@@ -303,6 +312,9 @@ MeshResult mesh(const py::object& source, const py::kwargs& kwargs) {
                            {"refinement", app::refinement_json(made.stats)},
                            {"estimated_triangles", std::llround(made.estimated_triangles)},
                            {"quality", app::to_json(g.quality)},
+                           {"outer_only", outer_only},
+                           {"components_dropped", dropped},
+                           {"skin_area", app::skin_area_json(area, g.quality.area)},
                            {"on_surface_error", app::to_json(g.surface_error)},
                            {"guarantees", app::guarantees_json(g)},
                            {"seconds", seconds}};

@@ -801,3 +801,23 @@ TEST_CASE("the example at the end of every command's help runs as written", "[cl
   }
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("mesh --outer-only keeps the outer surface; the report gives the skin's own area", "[cli][mesh]") {
+  skinmesh::test::TempFile out("outer.ply");
+  skinmesh::test::TempFile report("outer.json");
+  const Run r = run("--quiet mesh " + skinmesh::test::data_file("1ubi.pdb") + " -o " + out.path() + " --outer-only --report " +
+                    report.path());
+  REQUIRE(r.code == 0);
+  std::ifstream in(report.path());
+  const auto j = nlohmann::json::parse(in);
+  CHECK(j["outer_only"] == true);
+  CHECK(j["quality"]["components"] == 1);  // 1ubi: one outer surface and ten cavities
+  CHECK(j["quality"]["cavities"] == 0);
+  CHECK(j["components_dropped"] == 10);
+  CHECK(j["guarantees"]["min_angle_at_least_bound"] == true);
+  const auto& area = j["skin_area"];
+  CHECK(area["converged"] == true);
+  CHECK(area["mesh"].get<double>() == j["quality"]["area"].get<double>());
+  CHECK(area["skin"].get<double>() > area["mesh"].get<double>());  // chords cut the convex skin short
+  CHECK(area["uncertainty"].get<double>() < 1e-3 * area["skin"].get<double>());
+}

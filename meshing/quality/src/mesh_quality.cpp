@@ -4,6 +4,7 @@
 #include "union_find.hpp"
 
 #include <Eigen/Geometry>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 
@@ -176,6 +177,70 @@ SurfaceComponents surface_components(const SurfaceMesh& mesh) {
     const auto& V = mesh.vertices;
     out.enclosed_volume[static_cast<size_t>(l)] +=
         V[static_cast<size_t>(t[0])].dot(V[static_cast<size_t>(t[1])].cross(V[static_cast<size_t>(t[2])])) / 6.0;
+  }
+  return out;
+}
+
+namespace {
+
+// The solid angle of triangle abc seen from x, signed (Van Oosterom and
+// Strackee 1983): summed over a closed surface it is 4 pi times the
+// winding number of the surface about x.
+double solid_angle(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d p = a - x, q = b - x, r = c - x;
+  const double lp = p.norm(), lq = q.norm(), lr = r.norm();
+  const double numerator = p.dot(q.cross(r));
+  const double denominator = lp * lq * lr + p.dot(q) * lr + q.dot(r) * lp + r.dot(p) * lq;
+  return 2 * std::atan2(numerator, denominator);
+}
+
+}  // namespace
+
+std::vector<char> enclosed_components(const SurfaceMesh& mesh, const SurfaceComponents& components) {
+  const size_t count = components.enclosed_volume.size();
+  std::vector<int> witness(count, -1);  // one vertex per component
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    int& w = witness[static_cast<size_t>(components.of_triangle[f])];
+    if (w < 0) w = mesh.triangles[f][0];
+  }
+  std::vector<char> enclosed(count, 0);
+  tbb::parallel_for(size_t{0}, count, [&](size_t c) {
+    const Eigen::Vector3d& x = mesh.vertices[static_cast<size_t>(witness[c])];
+    std::vector<double> winding(count, 0.0);
+    for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+      const size_t other = static_cast<size_t>(components.of_triangle[f]);
+      if (other == c) continue;
+      const std::array<int, 3>& t = mesh.triangles[f];
+      winding[other] += solid_angle(x, mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
+                                    mesh.vertices[static_cast<size_t>(t[2])]);
+    }
+    for (size_t other = 0; other < count; ++other)
+      if (other != c && std::abs(winding[other]) > 2 * M_PI) enclosed[c] = 1;  // |winding number| 1, not 0
+  });
+  return enclosed;
+}
+
+SurfaceMesh outer_surface(const SurfaceMesh& mesh, std::vector<int>* kept_from) {
+  const SurfaceComponents components = surface_components(mesh);
+  const std::vector<char> enclosed = enclosed_components(mesh, components);
+  std::vector<int> index(mesh.vertices.size(), -1);
+  SurfaceMesh out;
+  if (kept_from) kept_from->clear();
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (enclosed[static_cast<size_t>(components.of_triangle[f])]) continue;
+    std::array<int, 3> t = mesh.triangles[f];
+    for (int& v : t) {
+      int& i = index[static_cast<size_t>(v)];
+      if (i < 0) {
+        i = static_cast<int>(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[static_cast<size_t>(v)]);
+        if (mesh.normals.size() == mesh.vertices.size()) out.normals.push_back(mesh.normals[static_cast<size_t>(v)]);
+        if (mesh.cells.size() == mesh.vertices.size()) out.cells.push_back(mesh.cells[static_cast<size_t>(v)]);
+        if (kept_from) kept_from->push_back(v);
+      }
+      v = i;
+    }
+    out.triangles.push_back(t);
   }
   return out;
 }

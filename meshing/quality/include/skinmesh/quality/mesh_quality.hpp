@@ -65,4 +65,13 @@ struct SurfaceComponents {
 };
 SurfaceComponents surface_components(const SurfaceMesh& mesh);
 
+// Per component of a closed mesh: whether another component encloses it
+// (the winding number of one of its vertices about that component's
+// triangles is not 0): a cavity's surface, an island inside a cavity. The
+// components no other encloses are the outer surface.
+std::vector<char> enclosed_components(const SurfaceMesh& mesh, const SurfaceComponents& components);
+// The mesh without its enclosed components; `kept_from` (when given) gets
+// each kept vertex's index in `mesh`.
+SurfaceMesh outer_surface(const SurfaceMesh& mesh, std::vector<int>* kept_from = nullptr);
+
 }  // namespace skinmesh
