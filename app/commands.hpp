@@ -73,6 +73,7 @@ void add_quality_command(CLI::App& app, const GlobalOptions& global, int& exit_c
 void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
+void add_render_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_morph_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_trajectory_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 

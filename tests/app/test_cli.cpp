@@ -785,7 +785,7 @@ TEST_CASE("the example at the end of every command's help runs as written", "[cl
   const std::string dir = holder.path() + "-examples";
   std::filesystem::create_directory(dir);
   // In the order that makes what a later example reads (quality reads mesh's output).
-  for (const char* command : {"info", "mesh", "quality", "volume", "interpolate", "morph", "trajectory"}) {
+  for (const char* command : {"info", "mesh", "quality", "volume", "interpolate", "morph", "trajectory", "render"}) {
     INFO(command);
     const Run help = run(std::string(command) + " --help");
     const size_t at = help.output.find("Example:\n  ");
@@ -820,4 +820,25 @@ TEST_CASE("mesh --outer-only keeps the outer surface; the report gives the skin'
   CHECK(area["mesh"].get<double>() == j["quality"]["area"].get<double>());
   CHECK(area["skin"].get<double>() > area["mesh"].get<double>());  // chords cut the convex skin short
   CHECK(area["uncertainty"].get<double>() < 1e-3 * area["skin"].get<double>());
+}
+
+TEST_CASE("render draws a molecule's skin or a mesh file into a PNG", "[cli][render]") {
+  skinmesh::test::TempFile png("pept.png");
+  skinmesh::test::TempFile ply("pept-render.ply");
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  const Run drawn = run("--json render " + pept + " -o " + png.path() + " --colour element --width 200 --height 150");
+  REQUIRE(drawn.code == 0);
+  const auto j = nlohmann::json::parse(drawn.output.substr(drawn.output.find('{')));
+  CHECK(j["covered_pixels"].get<long>() > 200 * 150 / 10);  // the skin fills a good part of the picture
+  CHECK(j["covered_pixels"].get<long>() < 200 * 150);       // and leaves background
+  std::ifstream in(png.path(), std::ios::binary);
+  std::string signature(8, '\0');
+  in.read(&signature[0], 8);
+  CHECK(signature == std::string("\x89PNG\r\n\x1a\n", 8));
+  REQUIRE(run("--quiet mesh " + pept + " -o " + ply.path()).code == 0);
+  const Run mesh = run("--json render " + ply.path() + " -o " + png.path());
+  REQUIRE(mesh.code == 0);
+  CHECK(mesh.output.find("\"colour\": \"uniform\"") != std::string::npos);
+  const Run missing = run("render /nonexistent/x.pdb -o " + png.path());
+  CHECK(missing.code == 2);
 }

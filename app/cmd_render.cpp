@@ -1,0 +1,126 @@
+// skinmesh render: a PNG picture of a molecule's skin (meshed first, coloured
+// by patch type, element or chain) or of any mesh file, without a display.
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "molecule_options.hpp"
+#include "output_file.hpp"
+#include "quality_report.hpp"
+
+#include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/error.hpp"
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/mesh_io/mesh_read.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/render/render.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <iostream>
+#include <map>
+
+namespace skinmesh::app {
+namespace {
+
+using json = nlohmann::json;
+
+struct RenderCommandOptions {
+  MoleculeOptions molecule;  // the input: a molecule, or a mesh file by its extension
+  std::string output;
+  std::string colour = "patch";
+  RenderOptions view;
+};
+
+void add_render_options(CLI::App& cmd, RenderCommandOptions& o) {
+  cmd.add_option("input", o.molecule.path,
+                 "a molecule (meshed with the defaults of `mesh`), or a mesh file (.ply .off .obj .stl .msh .vert)")
+      ->required();
+  add_molecule_settings(cmd, o.molecule);
+  cmd.add_option("--output,-o", o.output, "PNG file")->required();
+  cmd.add_option("--colour,--color", o.colour,
+                 "a molecule's vertices by patch (sphere, saddle, concave), element, chain, or uniform; a mesh file "
+                 "is uniform")
+      ->check(CLI::IsMember({"patch", "element", "chain", "uniform"}));
+  cmd.add_option("--width", o.view.width, "pixels")->check(CLI::Range(16, 8192));
+  cmd.add_option("--height", o.view.height, "pixels")->check(CLI::Range(16, 8192));
+  cmd.add_option("--yaw", o.view.yaw, "degrees about the vertical axis")->check(finite_number());
+  cmd.add_option("--pitch", o.view.pitch, "degrees about the horizontal axis, after the yaw")->check(finite_number());
+}
+
+bool is_mesh_file(const std::string& path) {
+  for (const char* ext : {".ply", ".off", ".obj", ".stl", ".msh", ".vert", ".face"})
+    if (path.size() > std::string(ext).size() && path.compare(path.size() - std::string(ext).size(), std::string::npos, ext) == 0)
+      return true;
+  return false;
+}
+
+// A colour per distinct key, from a palette that tells neighbours apart.
+Colour palette(size_t k) {
+  static const Colour colours[] = {{0.38f, 0.62f, 0.85f}, {0.95f, 0.62f, 0.30f}, {0.45f, 0.75f, 0.45f},
+                                   {0.85f, 0.40f, 0.45f}, {0.65f, 0.52f, 0.80f}, {0.70f, 0.60f, 0.45f},
+                                   {0.90f, 0.55f, 0.75f}, {0.60f, 0.60f, 0.60f}};
+  return colours[k % (sizeof colours / sizeof colours[0])];
+}
+
+Colour element_colour(const std::string& element) {  // the usual CPK hues, softened
+  static const std::map<std::string, Colour> known = {{"C", {0.72f, 0.72f, 0.72f}}, {"N", {0.40f, 0.52f, 0.92f}},
+                                                      {"O", {0.92f, 0.38f, 0.35f}}, {"S", {0.95f, 0.85f, 0.35f}},
+                                                      {"P", {0.98f, 0.60f, 0.25f}}, {"H", {0.95f, 0.95f, 0.95f}}};
+  const auto found = known.find(element);
+  return found != known.end() ? found->second : Colour{0.85f, 0.55f, 0.85f};
+}
+
+// The skin of the molecule, meshed, and a colour per vertex.
+SurfaceMesh molecule_mesh(const RenderCommandOptions& o, std::vector<Colour>& colours) {
+  const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
+  if (m.atoms.empty()) input_error(o.molecule.path, 0, "no atoms left to mesh");
+  const SkinComplex complex = build_skin_complex(balls_from_molecule(m, o.molecule.shrink, o.molecule.convention()),
+                                                 {o.molecule.shrink});
+  SkinMeshResult made = mesh_skin(complex);
+  if (made.status == MeshingStatus::empty_skin) input_error(o.molecule.path, 0, made.message);
+  if (made.status != MeshingStatus::ok) throw Error(o.molecule.path + ": " + made.message);
+  std::map<std::string, size_t> chains;
+  for (const Atom& a : m.atoms) chains.emplace(a.chain, chains.size());
+  if (o.colour != "uniform")
+    for (size_t v = 0; v < made.mesh.vertices.size(); ++v) {
+      const int cell = made.mesh.cells[v];
+      const Atom& atom = m.atoms[static_cast<size_t>(complex.owning_ball(made.mesh.vertices[v], cell))];
+      if (o.colour == "patch") {
+        static const Colour by_dim[] = {{0.45f, 0.65f, 0.90f}, {0.98f, 0.80f, 0.40f}, {0.95f, 0.55f, 0.35f},
+                                        {0.85f, 0.35f, 0.40f}};
+        colours.push_back(by_dim[complex.cell(cell).dim]);
+      } else if (o.colour == "element") {
+        colours.push_back(element_colour(atom.element));
+      } else {
+        colours.push_back(palette(chains[atom.chain]));
+      }
+    }
+  return std::move(made.mesh);
+}
+
+ExitCode run_render(const RenderCommandOptions& o, const GlobalOptions& global) {
+  check_writable({o.output});
+  std::vector<Colour> colours;
+  const SurfaceMesh mesh = is_mesh_file(o.molecule.path) ? read_surface_mesh(o.molecule.path) : molecule_mesh(o, colours);
+  if (mesh.triangles.empty()) input_error(o.molecule.path, 0, "no triangles to draw");
+  const Image image = render_mesh(mesh, o.view, colours);
+  write_file_atomically(o.output, [&](std::ostream& out) { write_png(out, image); });
+  const json report = {{"input", o.molecule.path},           {"output", o.output},
+                       {"width", image.width},               {"height", image.height},
+                       {"covered_pixels", image.covered},    {"pixels_per_angstrom", image.pixels_per_angstrom},
+                       {"triangles", mesh.triangles.size()}, {"colour", is_mesh_file(o.molecule.path) ? "uniform" : o.colour}};
+  if (global.json) std::cout << json_text(report) << "\n";
+  else if (!global.quiet)
+    std::cout << o.output << ": " << image.width << " x " << image.height << " pixels, " << mesh.triangles.size()
+              << " triangles drawn, " << image.covered << " pixels covered\n";
+  return ExitCode::ok;
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app, const GlobalOptions& global, int& exit_code) {
+  add_command(app, "render", "a PNG picture of a molecule's skin or of a mesh file, without a display", global,
+              exit_code, add_render_options, run_render);
+}
+
+}  // namespace skinmesh::app
