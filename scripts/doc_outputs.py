@@ -10,8 +10,12 @@ A block of printed output in a doc is marked by the line before it:
     ...what the commands print on stdout, in order...
     ```
 
+or, for a Markdown table the commands print, by the line before the table
+(the block then runs to the next blank line).
+
 The commands run one after another in a temporary directory, with
-`./build/` standing for BUILD_DIR and `data/` for the repository's data/
+`./build/` standing for BUILD_DIR, `scripts/` and `data/` for the
+repository's
 (and the data directory's absolute path written back as `data/` in what
 they print). `check` compares every marked block with the output, except
 the numbers on lines holding `time:`, and exits 1 with a diff when one
@@ -27,7 +31,8 @@ import tempfile
 
 MARKER = re.compile(r"^<!-- output: (.*) -->$")
 NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
-DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data")
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DATA = os.path.join(ROOT, "data")
 
 
 def comparable(line):
@@ -41,12 +46,17 @@ def marked_blocks(lines, path):
         m = MARKER.match(line.strip())
         if not m:
             continue
+        commands = [c.strip() for c in m.group(1).split(" ; ")]
+        if i + 1 < len(lines) and lines[i + 1].startswith("|"):  # a table, to the next blank line
+            end = next((j for j in range(i + 1, len(lines)) if not lines[j].strip()), len(lines))
+            found.append((commands, i + 1, end))
+            continue
         if i + 1 >= len(lines) or not lines[i + 1].startswith("```"):
-            sys.exit("%s:%d: an output marker must be followed by a fenced block" % (path, i + 1))
+            sys.exit("%s:%d: an output marker must be followed by a fenced block or a table" % (path, i + 1))
         end = next((j for j in range(i + 2, len(lines)) if lines[j].startswith("```")), None)
         if end is None:
             sys.exit("%s:%d: the fenced block is not closed" % (path, i + 2))
-        found.append(([c.strip() for c in m.group(1).split(" ; ")], i + 2, end))
+        found.append((commands, i + 2, end))
     return found
 
 
@@ -56,7 +66,7 @@ def run(commands, build_dir):
         for command in commands:
             words = shlex.split(command)
             words = [os.path.join(build_dir, w[len("./build/"):]) if w.startswith("./build/") else
-                     os.path.join(DATA, w[len("data/"):]) if w.startswith("data/") else w for w in words]
+                     os.path.join(ROOT, w) if w.startswith(("data/", "scripts/")) else w for w in words]
             done = subprocess.run(words, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
             if done.returncode != 0:
                 raise RuntimeError("%s: exit %d\n%s" % (command, done.returncode, done.stderr))
