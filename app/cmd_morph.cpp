@@ -154,6 +154,11 @@ Sides read_sides(const MorphCommandOptions& o) {
   s.unmoved = snap_unmoved(s.source, s.target);
   s.source_balls = balls_from_molecule(s.source, o.molecule.shrink, o.molecule.convention());
   s.target_balls = balls_from_molecule(s.target, o.molecule.shrink, o.molecule.convention());
+  const auto empty = [](const std::vector<Ball>& balls) {
+    return std::none_of(balls.begin(), balls.end(), [](const Ball& b) { return b.weight > 0; });
+  };
+  if (empty(s.source_balls)) input_error(o.source, 0, "the skin of this ball set is empty: no ball has a positive weight");
+  if (empty(s.target_balls)) input_error(o.target, 0, "the skin of this ball set is empty: no ball has a positive weight");
   return s;
 }
 
@@ -438,7 +443,7 @@ std::vector<double> change_spaced(size_t frames, const std::function<std::vector
   return t;
 }
 
-ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
+ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   std::vector<double> times = frame_times(o);
@@ -515,6 +520,16 @@ ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
     std::cout << o.directory << ": " << counts.text() << ", alignment " << alignment_method_name(sides.alignment.used) << ", "
               << morph.events().size() << " topology events, " << report["seconds"].get<double>() << " s\n";
   return ExitCode::ok;
+}
+
+// A frame the mesher refuses is answered as `mesh` answers: an empty skin
+// is bad input (exit 2), a budget or another refusal a job refused (exit 3).
+ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
+  try {
+    return run_morph_frames(o, global);
+  } catch (const MeshingFailed& e) {
+    return refused_meshing(e, o.source + " -> " + o.target);
+  }
 }
 
 }  // namespace

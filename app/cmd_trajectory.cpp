@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "molecule_options.hpp"
+#include "meshing_feedback.hpp"
 #include "morph_frames.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
@@ -124,7 +125,7 @@ std::vector<std::vector<Ball>> keyframe_balls(const TrajectoryOptions& o, const 
   return out;
 }
 
-ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global) {
+ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   const std::vector<Molecule> all = read_all_models(o.molecule.path, o.molecule.read);
@@ -203,6 +204,15 @@ ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global)
               << result.min_ids_kept * 100
               << "% or more a frame, " << report["seconds"].get<double>() << " s\n";
   return ExitCode::ok;
+}
+
+// A frame the mesher refuses: as `mesh` answers it (refused_meshing).
+ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global) {
+  try {
+    return run_trajectory_frames(o, global);
+  } catch (const MeshingFailed& e) {
+    return refused_meshing(e, o.molecule.path);
+  }
 }
 
 }  // namespace

@@ -30,6 +30,13 @@ std::function<void(const MeshingProgress&)> meshing_progress_line(std::shared_pt
   };
 }
 
+ExitCode refused_meshing(const MeshingFailed& failure, const std::string& what) {
+  std::fprintf(stderr, "\nskinmesh: error: %s: %s\n", what.c_str(), failure.what());
+  if (failure.status == MeshingStatus::over_budget)
+    std::fprintf(stderr, "skinmesh: raise --max-triangles, or ask for coarser sizes (--epsilon, --edge-length)\n");
+  return failure.status == MeshingStatus::empty_skin ? ExitCode::bad_input : ExitCode::not_met;
+}
+
 namespace {
 
 const char* flag_of(SizeOption option, bool surface_sizes_only) {

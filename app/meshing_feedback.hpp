@@ -2,6 +2,7 @@
 // shared by `mesh` and `volume`.
 #pragma once
 
+#include "exit_codes.hpp"
 #include "progress.hpp"
 
 #include "skinmesh/mesher/skin_mesher.hpp"
@@ -20,6 +21,10 @@ std::function<void(const MeshingProgress&)> meshing_progress_line(std::shared_pt
 // (from SkinMeshResult::fitting_sizes), or the general advice. A command with
 // only --epsilon and --edge-length (volume) passes surface_sizes_only.
 std::string over_budget_hint(const SkinMeshResult& result, bool surface_sizes_only = false);
+
+// A mesh refused inside a longer job (a morph's frame), said on stderr with
+// `what` (the inputs) and answered with the exit code `mesh` would give.
+ExitCode refused_meshing(const MeshingFailed& failure, const std::string& what);
 
 // Bytes of memory this process may still use: the smaller of the system's
 // available memory (/proc/meminfo MemAvailable) and what its cgroup's limit

@@ -92,7 +92,8 @@ Morph::Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<Bal
 
 void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t) {
   SkinMeshResult made = mesh_skin(next, criteria);
-  if (made.status != MeshingStatus::ok) throw Error("morph frame at t = " + std::to_string(t) + ": " + made.message);
+  if (made.status != MeshingStatus::ok)
+    throw MeshingFailed(made.status, "morph frame at t = " + std::to_string(t) + ": " + made.message);
   frame_.mesh = std::move(made.mesh);
   frame_.ids.resize(frame_.mesh.vertices.size());
   for (long& id : frame_.ids) id = next_id_++;

@@ -389,7 +389,7 @@ MovingBalls::MovingBalls(std::vector<Ball> balls, const MovingOptions& options, 
   frame_.stats.seconds_complex = seconds_since(start);
   const auto mesh_start = Clock::now();
   SkinMeshResult made = mesh_skin(complex_, with_size_margin(options.first, options.first_size_margin));
-  if (made.status != MeshingStatus::ok) throw Error("moving balls, first frame: " + made.message);
+  if (made.status != MeshingStatus::ok) throw MeshingFailed(made.status, "moving balls, first frame: " + made.message);
   frame_.mesh = std::move(made.mesh);
   frame_.ids.resize(frame_.mesh.vertices.size());
   std::iota(frame_.ids.begin(), frame_.ids.end(), 0L);
@@ -526,7 +526,8 @@ void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, 
   const bool remeshed = remesh(next, moved, lost, repair_criteria());
   if (!remeshed || mesh_topology(frame_.mesh) != topology) {
     SkinMeshResult made = mesh_skin(next, repair_criteria());
-    if (made.status != MeshingStatus::ok) throw Error("moving balls: a step the mesher cannot mesh: " + made.message);
+    if (made.status != MeshingStatus::ok)
+      throw MeshingFailed(made.status, "moving balls: a step the mesher cannot mesh: " + made.message);
     frame_.mesh = std::move(made.mesh);
     frame_.ids.resize(frame_.mesh.vertices.size());
     for (long& id : frame_.ids) id = next_id_++;

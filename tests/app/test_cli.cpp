@@ -842,3 +842,31 @@ TEST_CASE("render draws a molecule's skin or a mesh file into a PNG", "[cli][ren
   const Run missing = run("render /nonexistent/x.pdb -o " + png.path());
   CHECK(missing.code == 2);
 }
+
+TEST_CASE("a morph whose frame the mesher refuses exits as mesh does, naming the inputs, writing nothing", "[cli][bad][morph]") {
+  skinmesh::test::TempFile negative("negative.wpts", "0 0 0 -1\n5 0 0 -2\n");
+  skinmesh::test::TempFile here("here.xyzr", "0 0 0 1.5\n");
+  skinmesh::test::TempFile far("far.xyzr", "100 0 0 1.5\n");
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  const std::string dir = negative.path() + "-morph";
+  struct Case {
+    std::string args;
+    int code;
+    std::vector<std::string> says;
+  };
+  const std::vector<Case> cases{
+      {"morph " + negative.path() + " " + pept, 2, {negative.path(), "empty"}},  // an empty side: bad input
+      {"morph " + pept + " " + negative.path(), 2, {negative.path(), "empty"}},
+      {"morph " + here.path() + " " + far.path() + " --align none --pairs all", 2,  // B(1/2) empty
+       {here.path(), far.path(), "empty"}},
+      {"morph " + pept + " " + skinmesh::test::data_file("3al1.pdb") + " --max-triangles 100", 3,  // over budget
+       {"budget", "--max-triangles"}},
+  };
+  for (const Case& c : cases) {
+    INFO(c.args);
+    const Run r = run(c.args + " --frames 3 -o " + dir);
+    CHECK(r.code == c.code);
+    for (const std::string& s : c.says) CHECK(r.output.find(s) != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir));
+  }
+}

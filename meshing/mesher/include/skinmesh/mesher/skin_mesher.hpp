@@ -136,6 +136,16 @@ enum class MeshingStatus {
 };
 const char* meshing_status_name(MeshingStatus status);
 
+// Thrown by callers that mesh inside a longer job (a morph's frames) when
+// the mesher returns a status other than ok: the status says which, so that
+// a command can answer as `mesh` does (an empty skin is bad input, a
+// budget refusal a job refused).
+class MeshingFailed : public Error {
+ public:
+  MeshingFailed(MeshingStatus status, const std::string& message) : Error(message), status(status) {}
+  MeshingStatus status;
+};
+
 // Size options changed, together, to values at which the estimate, even at
 // the high end of its spread, fits the budget: what a refused job could ask
 // for.
