@@ -444,6 +444,7 @@ std::vector<double> change_spaced(size_t frames, const std::function<std::vector
 }
 
 ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& global) {
+  check_formats(o.formats);
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   std::vector<double> times = frame_times(o);

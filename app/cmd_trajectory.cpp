@@ -126,6 +126,7 @@ std::vector<std::vector<Ball>> keyframe_balls(const TrajectoryOptions& o, const 
 }
 
 ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& global) {
+  check_formats(o.formats);
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   const std::vector<Molecule> all = read_all_models(o.molecule.path, o.molecule.read);

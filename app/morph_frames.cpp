@@ -79,6 +79,12 @@ void FrameCounts::into(nlohmann::json& report) const {
   report["repairs"] = repairs;
 }
 
+void check_formats(const std::vector<std::string>& formats) {
+  for (size_t i = 0; i < formats.size(); ++i)
+    if (std::find(formats.begin(), formats.begin() + static_cast<long>(i), formats[i]) != formats.begin() + static_cast<long>(i))
+      contract_error("--format names " + formats[i] + " twice");
+}
+
 std::string frame_name(size_t k, const std::string& format) {
   char name[64];
   std::snprintf(name, sizeof name, "frame_%04zu.%s", k, format.c_str());

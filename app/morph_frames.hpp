@@ -43,6 +43,9 @@ class OutputDirectory {
 };
 
 std::string frame_name(size_t k, const std::string& format);  // frame_0007.ply
+// --format's list: each format once (a frame written twice under one name
+// would collide); throws ContractError naming the repeated one.
+void check_formats(const std::vector<std::string>& formats);
 // A VTK collection: ParaView opens it as an animation over t.
 void write_pvd(std::ostream& out, const std::vector<double>& times);
 // The share of the triangles whose smallest angle is under the bound (degrees).

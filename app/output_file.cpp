@@ -3,6 +3,8 @@
 #include "skinmesh/core/error.hpp"
 
 #include <cerrno>
+#include <filesystem>
+#include <map>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -43,6 +45,16 @@ void OutputSet::commit() {
 }
 
 void check_writable(const std::vector<std::string>& paths) {
+  // Two outputs named alike would be written one over the other, and the
+  // second rename would fail after the first: refused before any work.
+  std::map<std::filesystem::path, std::string> seen;
+  for (const std::string& path : paths) {
+    std::error_code error;
+    std::filesystem::path key = std::filesystem::weakly_canonical(std::filesystem::absolute(path), error);
+    if (error) key = std::filesystem::absolute(path).lexically_normal();
+    const auto [at, fresh] = seen.emplace(key, path);
+    if (!fresh) unusable_output(path, "is named for two outputs (as " + at->second + " and as " + path + ")");
+  }
   for (const std::string& path : paths) {
     struct stat info {};
     if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) unusable_output(path, "is a directory");

@@ -870,3 +870,28 @@ TEST_CASE("a morph whose frame the mesher refuses exits as mesh does, naming the
     CHECK_FALSE(std::filesystem::exists(dir));
   }
 }
+
+TEST_CASE("outputs named alike are refused before any work, naming both", "[cli][bad]") {
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  skinmesh::test::TempFile holder("x");
+  const std::string base = holder.path() + "-alike";
+  struct Case {
+    std::string args, says;
+    std::vector<std::string> never;  // files that must not exist afterwards
+  };
+  const std::vector<Case> cases{
+      {"mesh " + pept + " -o " + base + ".ply --report " + base + ".ply", base + ".ply", {base + ".ply"}},
+      {"mesh " + pept + " -o " + base + ".ply --svg " + base + "/../" + base.substr(base.rfind('/') + 1) + ".ply",
+       "two outputs", {base + ".ply"}},
+      {"volume " + pept + " -o " + base + " --report " + base + ".msh", base + ".msh",
+       {base + ".msh", base + ".vtu"}},
+      {"morph " + pept + " " + pept + " --frames 3 --format ply,ply -o " + base + "-dir", "ply twice", {base + "-dir"}},
+  };
+  for (const Case& c : cases) {
+    INFO(c.args);
+    const Run r = run("--quiet " + c.args);
+    CHECK(r.code == 2);
+    CHECK(r.output.find(c.says) != std::string::npos);
+    for (const std::string& f : c.never) CHECK_FALSE(std::filesystem::exists(f));
+  }
+}
