@@ -9,6 +9,7 @@
 #include "skinmesh/core/error.hpp"
 
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,13 @@ int main(int argc, char** argv) {
   } catch (const skinmesh::ContractError& e) {
     std::cerr << "skinmesh: error: " << e.what() << "\n";
     return code(skinmesh::app::ExitCode::bad_input);
+  } catch (const std::bad_alloc&) {
+    // The estimates refuse most jobs too large at once; this is one that
+    // got past them (or a limit they cannot see).
+    std::cerr << "skinmesh: error: out of memory running `" << global.command_line
+              << "`: the job needs more than this process may use (ulimit -v, the cgroup's limit or the machine's "
+                 "memory); nothing written\n";
+    return code(skinmesh::app::ExitCode::not_met);
   } catch (const std::exception& e) {
     std::cerr << "skinmesh: error: " << e.what() << "\n";
     return code(skinmesh::app::ExitCode::failure);

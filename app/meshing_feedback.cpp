@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <sys/resource.h>
+#include <unistd.h>
 
 namespace skinmesh::app {
 
@@ -110,6 +112,16 @@ double available_memory_bytes() {
   double available = meminfo_available();
   const double limit = number_in("/sys/fs/cgroup/memory.max"), used = number_in("/sys/fs/cgroup/memory.current");
   if (limit > 0 && used >= 0) available = available > 0 ? std::min(available, limit - used) : limit - used;
+  // An address-space limit (ulimit -v) binds the process's virtual size,
+  // which is more than what it has touched: what is left of it.
+  struct rlimit address_space {};
+  if (::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur != RLIM_INFINITY) {
+    long pages = 0;
+    std::ifstream statm("/proc/self/statm");
+    statm >> pages;
+    const double left = static_cast<double>(address_space.rlim_cur) - static_cast<double>(pages) * ::sysconf(_SC_PAGESIZE);
+    available = available > 0 ? std::min(available, left) : left;
+  }
   return std::max(0.0, available);
 }
 

@@ -895,3 +895,34 @@ TEST_CASE("outputs named alike are refused before any work, naming both", "[cli]
     for (const std::string& f : c.never) CHECK_FALSE(std::filesystem::exists(f));
   }
 }
+
+TEST_CASE("out of memory is an error naming the job, exit 3, nothing written", "[cli][bad][oom]") {
+  // Under an address-space limit that the morph's first frame exceeds.
+  skinmesh::test::TempFile holder("x");
+  const std::string dir = holder.path() + "-oom";
+  const std::string command = "ulimit -v 150000; " + std::string(SKINMESH_BINARY) + " --quiet morph " +
+                              skinmesh::test::data_file("3al1.pdb") + " " + skinmesh::test::data_file("1ubi.pdb") +
+                              " --frames 3 -o " + dir + " > " + holder.path() + " 2>&1";
+  const int status = std::system(("bash -c '" + command + "'").c_str());
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 3);
+  std::ifstream said(holder.path());
+  std::stringstream text;
+  text << said.rdbuf();
+  CHECK(text.str().find("out of memory running") != std::string::npos);
+  CHECK(text.str().find("3al1.pdb") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir));
+  // The estimate before meshing counts the limit as memory: a mesh that
+  // cannot fit under it is refused at once with the sizes that would.
+  const std::string mesh = "ulimit -v 400000; " + std::string(SKINMESH_BINARY) + " --quiet mesh " +
+                           skinmesh::test::data_file("3mht.pdb") + " --epsilon 0.3 -o " + dir + ".ply > " +
+                           holder.path() + " 2>&1";
+  const int refused = std::system(("bash -c '" + mesh + "'").c_str());
+  REQUIRE(WIFEXITED(refused));
+  CHECK(WEXITSTATUS(refused) == 3);
+  std::ifstream said_mesh(holder.path());
+  std::stringstream mesh_text;
+  mesh_text << said_mesh.rdbuf();
+  CHECK(mesh_text.str().find("more than the memory allows") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir + ".ply"));
+}
