@@ -139,7 +139,7 @@ void print_text(const json& j, std::ostream& out) {
 void add_info_command(CLI::App& app, const GlobalOptions& global, int& exit_code) {
   auto options = std::make_shared<MoleculeOptions>();
   CLI::App* cmd = app.add_subcommand("info", "atoms, radii and the skin complex of a molecule");
-  add_molecule_options(*cmd, *options);
+  add_molecule_options(*cmd, *options, ModelChoice::one_or_all);
   cmd->callback([options, &global, &exit_code]() {
     std::vector<Molecule> molecules;
     if (options->all_models)

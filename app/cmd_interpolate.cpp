@@ -23,9 +23,11 @@ namespace skinmesh::app {
 namespace {
 
 std::vector<Ball> read_balls(const std::string& path, ReadOptions read, int model, const MoleculeOptions& o,
-                             bool centre) {
+                             bool centre, bool warn) {
   read.model = model;
   const Molecule m = read_molecule(path, read);
+  if (warn)
+    for (const std::string& w : m.warnings) std::cerr << "skinmesh: warning: " << w << "\n";
   std::vector<Ball> balls = balls_from_molecule(m, o.shrink, o.convention());
   if (centre) centre_balls(balls);
   return balls;
@@ -53,15 +55,16 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
   cmd->add_flag("--centre,--center", o->centre, "move each molecule's centroid to the origin first");
   cmd->add_option("--source-model", o->source_model, "1-based model of the source file")->check(finite_number())->check(positive_number());
   cmd->add_option("--target-model", o->target_model, "1-based model of the target file")->check(finite_number())->check(positive_number());
-  add_molecule_settings(*cmd, o->molecule);
+  add_molecule_settings(*cmd, o->molecule, ModelChoice::none);
   cmd->callback([o, &global, &exit_code]() {
     if (!has_extension(lowercase(o->output), ".wpts"))
       contract_error(o->output + ": interpolated weights can be negative, which XYZR cannot hold; "
                                   "write weighted points, OUT.wpts");
     check_writable({o->output});
     const auto t0 = Clock::now();
-    const std::vector<Ball> a = read_balls(o->source, o->molecule.read, o->source_model, o->molecule, o->centre);
-    const std::vector<Ball> b = read_balls(o->target, o->molecule.read, o->target_model, o->molecule, o->centre);
+    const bool warn = !global.quiet && !global.json;
+    const std::vector<Ball> a = read_balls(o->source, o->molecule.read, o->source_model, o->molecule, o->centre, warn);
+    const std::vector<Ball> b = read_balls(o->target, o->molecule.read, o->target_model, o->molecule, o->centre, warn);
     // All m*n pairs take 40 bytes each (the pair and its ball): refuse what
     // would not fit rather than die in the allocation.
     constexpr double kMaxAllPairs = 2e7;

@@ -102,7 +102,7 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
                                         "(frames.pvd needs vtp)")
       ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl"}))->capture_default_str();
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
-  add_molecule_settings(cmd, o.molecule);
+  add_molecule_settings(cmd, o.molecule, ModelChoice::none);
 }
 
 // The frame times asked for: increasing, in [0, 1].
@@ -464,6 +464,8 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
     }
   }
   if (progress) {
+    for (const auto& [path, m] : {std::pair{o.source, &sides.source}, std::pair{o.target, &sides.target}})
+      for (const std::string& w : m->warnings) std::cerr << "skinmesh: warning: " << w << "\n";
     print_alignment(sides);
     std::cerr << "skinmesh: pairs " << (pairing.matched ? "matched" : "all") << ": " << pairing.why << "\n";
   }

@@ -65,7 +65,7 @@ void add_trajectory_options(CLI::App& cmd, TrajectoryOptions& o) {
   cmd.add_option("--format", o.formats, "mesh formats per frame, comma-separated: ply vtp off obj stl")
       ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl"}))->capture_default_str();
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
-  add_molecule_settings(cmd, o.molecule);
+  add_molecule_settings(cmd, o.molecule, ModelChoice::none);
 }
 
 // The 1-based model numbers --models and --every select among `count`.

@@ -23,10 +23,17 @@ struct MoleculeOptions {
   }
 };
 
+// Which model options a command takes: --model and --all-models (info),
+// --model alone (one molecule meshed), or none (morph, interpolate and
+// trajectory name their models their own way).
+enum class ModelChoice { one_or_all, one, none };
+
 // Filters, radii and skin parameters (without the file itself).
-inline void add_molecule_settings(CLI::App& cmd, MoleculeOptions& o) {
-  cmd.add_option("--model", o.read.model, "1-based model to read from a multi-model file")->check(finite_number())->check(positive_number());
-  cmd.add_flag("--all-models", o.all_models, "take every model (a list of conformations)");
+inline void add_molecule_settings(CLI::App& cmd, MoleculeOptions& o, ModelChoice models = ModelChoice::one) {
+  if (models != ModelChoice::none)
+    cmd.add_option("--model", o.read.model, "1-based model to read from a multi-model file")->check(finite_number())->check(positive_number());
+  if (models == ModelChoice::one_or_all)
+    cmd.add_flag("--all-models", o.all_models, "take every model (a list of conformations)");
   cmd.add_option("--chain", o.read.chains, "keep only these chains (repeatable)");
   cmd.add_flag("--keep-hydrogens", o.read.keep_hydrogens, "keep hydrogen atoms (dropped by default)");
   cmd.add_flag("--keep-waters", o.read.keep_waters, "keep water molecules (dropped by default)");
@@ -43,9 +50,9 @@ inline void add_molecule_settings(CLI::App& cmd, MoleculeOptions& o) {
 }
 
 // The molecule as the subcommand's positional argument, plus its settings.
-inline void add_molecule_options(CLI::App& cmd, MoleculeOptions& o) {
+inline void add_molecule_options(CLI::App& cmd, MoleculeOptions& o, ModelChoice models = ModelChoice::one) {
   cmd.add_option("molecule", o.path, "PDB, mmCIF (.cif), PQR, XYZR or weighted points (.wpts), optionally .gz")->required();
-  add_molecule_settings(cmd, o);
+  add_molecule_settings(cmd, o, models);
 }
 
 }  // namespace skinmesh::app

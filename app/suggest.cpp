@@ -67,7 +67,12 @@ std::string suggestion(const CLI::App& app, const std::vector<std::string>& args
     std::vector<std::string> known = option_names(*command);
     known.insert(known.end(), global.begin(), global.end());
     if (std::find(known.begin(), known.end(), word) != known.end()) continue;
-    const std::string near = nearest_name(word, known);
+    std::string near = nearest_name(word, known);
+    if (near.empty()) {  // no slip of the keys: the options that hold the word (--model: --source-model, --target-model)
+      const std::string bare = word.substr(word.find_first_not_of('-'));
+      for (const std::string& name : known)
+        if (bare.size() >= 3 && name.find(bare) != std::string::npos) near += (near.empty() ? "" : "' or '") + name;
+    }
     return "'" + word + "' is not an option of '" + command->get_name() + "'" +
            (near.empty() ? "" : "; did you mean '" + near + "'?");
   }

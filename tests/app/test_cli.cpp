@@ -335,6 +335,7 @@ TEST_CASE("every usage error exits 2, and a mistyped command or option is told t
       {"mesh " + pept + " -o " + out.path() + " --min-angle", "min-angle"},          // an option without its value
       {"mesh " + pept + " -o " + out.path() + " --tolerance 0", "must be greater than 0, not 0"},  // out of range
       {"mesh " + pept + " -o " + out.path() + " --edge-length -1", "must be 0 or more, not -1"},
+      {"morph " + pept + " " + pept + " --model 2 -o " + out.path(), "'--source-model' or '--target-model'"},
       {"mesh", "required"},                                                          // the input missing
       {"", "subcommand"},                                                            // no command
   };
@@ -925,4 +926,19 @@ TEST_CASE("out of memory is an error naming the job, exit 3, nothing written", "
   mesh_text << said_mesh.rdbuf();
   CHECK(mesh_text.str().find("more than the memory allows") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(dir + ".ply"));
+}
+
+TEST_CASE("morph and interpolate say what the readers warn of, as mesh does", "[cli][bad]") {
+  const std::string crambin = skinmesh::test::data_file("1ejg.pdb");  // two microheterogeneous residues
+  skinmesh::test::TempFile out("crambin.wpts");
+  const Run interpolate = run("interpolate " + crambin + " " + crambin + " --t 0.5 -o " + out.path());
+  CHECK(interpolate.code == 0);
+  CHECK(interpolate.output.find("warning: " + crambin + ": chain A residue 22 is microheterogeneous") != std::string::npos);
+  const std::string dir = out.path() + "-morph";
+  const Run morph = run("morph " + crambin + " " + crambin + " --frames 2 -o " + dir);
+  CHECK(morph.code == 0);
+  CHECK(morph.output.find("residue 25 is microheterogeneous") != std::string::npos);
+  std::filesystem::remove_all(dir);
+  CHECK(run("--quiet interpolate " + crambin + " " + crambin + " --t 0.5 -o " + out.path()).output.find("warning") ==
+        std::string::npos);
 }
