@@ -31,6 +31,7 @@ OutputDirectory::OutputDirectory(const std::string& path) : path_(path) {
   std::error_code error;
   if (fs::exists(path_, error)) {
     if (!fs::is_directory(path_, error)) unusable_output(path, "exists and is not a directory");
+    remove_stale_staging(path_);
     // Frames of an earlier run would be mixed with this run's (its extra
     // frames left behind): refused before any work.
     for (const auto& entry : fs::directory_iterator(path_, error)) {

@@ -2,7 +2,10 @@
 
 #include "skinmesh/core/error.hpp"
 
+#include <atomic>
 #include <cerrno>
+#include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <cstdio>
@@ -13,6 +16,34 @@
 
 namespace skinmesh::app {
 
+namespace {
+
+constexpr const char* kStagingPrefix = ".skinmesh-";  // .skinmesh-PID-N.tmp
+constexpr const char* kStagingSuffix = ".tmp";
+
+// A hidden, short name beside `path` for staging it: the target's own name
+// may be as long as the file system allows.
+std::string staging_name(const std::string& path) {
+  static std::atomic<long> counter{0};
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  return (folder / (kStagingPrefix + std::to_string(::getpid()) + "-" + std::to_string(counter++) + kStagingSuffix))
+      .string();
+}
+
+}  // namespace
+
+void remove_stale_staging(const std::filesystem::path& folder) {
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder.empty() ? "." : folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(kStagingPrefix, 0) != 0 || name.size() < 16 ||
+        name.compare(name.size() - 4, 4, kStagingSuffix) != 0)
+      continue;
+    const long pid = std::strtol(name.c_str() + std::strlen(kStagingPrefix), nullptr, 10);
+    if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) std::filesystem::remove(entry.path(), error);
+  }
+}
+
 void unusable_output(const std::string& path, const std::string& message) {
   throw UnusableOutput(path + ": " + message);
 }
@@ -22,13 +53,20 @@ OutputSet::~OutputSet() {
 }
 
 void OutputSet::add(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
+  const std::string temporary = staging_name(path);
   staged_.push_back({temporary, path, RemovedOnInterrupt(temporary)});  // removed by the destructor from here on
   std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
   if (!out) output_error(path, std::string("cannot write (") + std::strerror(errno) + ")");
-  write(out);
-  out.flush();
-  if (!out) output_error(path, "write failed");
+  // A writer's own error (a stream that failed under it: a full disk, a
+  // file size limit) is said with the file and the system's reason.
+  errno = 0;
+  try {
+    write(out);
+    out.flush();
+  } catch (const OutputError& e) {
+    output_error(path, std::string(e.what()) + (errno ? std::string(" (") + std::strerror(errno) + ")" : ""));
+  }
+  if (!out) output_error(path, std::string("write failed") + (errno ? std::string(" (") + std::strerror(errno) + ")" : ""));
 }
 
 void OutputSet::commit() {
@@ -58,7 +96,8 @@ void check_writable(const std::vector<std::string>& paths) {
   for (const std::string& path : paths) {
     struct stat info {};
     if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) unusable_output(path, "is a directory");
-    const std::string probe = path + ".tmp-" + std::to_string(::getpid());
+    remove_stale_staging(std::filesystem::path(path).parent_path());
+    const std::string probe = staging_name(path);
     std::ofstream out(probe, std::ios::binary | std::ios::trunc);
     if (!out) unusable_output(path, std::string("cannot write (") + std::strerror(errno) + ")");
     out.close();

@@ -9,6 +9,7 @@
 
 #include "skinmesh/core/error.hpp"
 
+#include <filesystem>
 #include <functional>
 #include <ostream>
 #include <string>
@@ -33,7 +34,8 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
   ~OutputSet();  // removes the temporaries not committed
 
-  // Writes PATH.tmp-PID now by calling write(stream). Throws OutputError.
+  // Writes a hidden staging file beside PATH (.skinmesh-PID-N.tmp) now by
+  // calling write(stream). Throws OutputError.
   void add(const std::string& path, const std::function<void(std::ostream&)>& write);
   // Renames every temporary into place. Throws OutputError when one cannot
   // be, after removing the temporaries left.
@@ -47,10 +49,15 @@ class OutputSet {
   std::vector<Staged> staged_;
 };
 
-// Checks, before any work, that each path can be written: not a directory,
+// Checks, before any work, that each path can be written (and removes the
+// staging files of killed runs beside it): not a directory,
 // in a folder that exists and takes a new file. Throws UnusableOutput naming the
 // first that cannot; leaves nothing behind.
 void check_writable(const std::vector<std::string>& paths);
+
+// Removes the staging files in `folder` that a run killed outright (SIGKILL,
+// a power cut) left: those whose process is gone. Others' are left alone.
+void remove_stale_staging(const std::filesystem::path& folder);
 
 // One output on its own: an OutputSet of one file, committed at once.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);

@@ -760,7 +760,7 @@ TEST_CASE("an interrupted command leaves no output behind", "[cli][bad][interrup
     auto staged = [&] {
       std::error_code error;
       for (const auto& entry : std::filesystem::directory_iterator(dir, error))
-        if (entry.path().filename().string().find(".tmp-") != std::string::npos) return true;
+        if (entry.path().filename().string().rfind(".skinmesh-", 0) == 0) return true;
       return false;
     };
     bool seen = false;
@@ -941,4 +941,44 @@ TEST_CASE("morph and interpolate say what the readers warn of, as mesh does", "[
   std::filesystem::remove_all(dir);
   CHECK(run("--quiet interpolate " + crambin + " " + crambin + " --t 0.5 -o " + out.path()).output.find("warning") ==
         std::string::npos);
+}
+
+TEST_CASE("a write the system refuses names the file and the reason, and leaves nothing", "[cli][bad]") {
+  skinmesh::test::TempFile holder("x");
+  const std::string mesh = holder.path() + "-limited.ply";
+  // A file size limit of 20 blocks (SIGXFSZ ignored, so write fails with EFBIG), as a full disk would.
+  const std::string command = "ulimit -f 20; trap \"\" XFSZ; " + std::string(SKINMESH_BINARY) + " --quiet mesh " +
+                              skinmesh::test::data_file("pept.pdb") + " -o " + mesh + " > " + holder.path() + " 2>&1";
+  const int status = std::system(("bash -c '" + command + "'").c_str());
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 1);  // the system refused (docs/commands.md)
+  std::ifstream said(holder.path());
+  std::stringstream text;
+  text << said.rdbuf();
+  CHECK(text.str().find(mesh + ": writing the mesh failed (File too large)") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(mesh));
+}
+
+TEST_CASE("a file name as long as the file system allows is written; a killed run's staging files are cleaned up",
+          "[cli][bad]") {
+  char pattern[] = "/tmp/skinmesh-names-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = pattern;
+  const std::string longest = dir + "/" + std::string(251, 'm') + ".ply";  // a 255-byte name
+  const Run r = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + longest);
+  CHECK(r.code == 0);
+  CHECK(std::filesystem::exists(longest));
+  // Staging files: one of a process that is gone, one of this (living) process.
+  const pid_t gone = fork();
+  REQUIRE(gone >= 0);
+  if (gone == 0) std::_Exit(0);
+  REQUIRE(waitpid(gone, nullptr, 0) == gone);
+  const std::string stale = dir + "/.skinmesh-" + std::to_string(gone) + "-0.tmp";
+  const std::string alive = dir + "/.skinmesh-" + std::to_string(getpid()) + "-0.tmp";
+  { std::ofstream(stale) << "left by a killed run"; }
+  { std::ofstream(alive) << "another run's, still staging"; }
+  CHECK(run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + dir + "/again.ply").code == 0);
+  CHECK_FALSE(std::filesystem::exists(stale));
+  CHECK(std::filesystem::exists(alive));
+  std::filesystem::remove_all(dir);
 }
