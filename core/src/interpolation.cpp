@@ -99,10 +99,15 @@ std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vec
   // refinement stalled (a molecule morphed onto itself). They are left out
   // and not walked through: the cells with volume are connected by facets
   // among themselves.
+  // Compared by the balls, not by index: a side may hold the same ball
+  // twice (a duplicated atom), and the pair of a ball with its own copy is
+  // that ball, never redundant.
   const std::vector<int> source_twin = twins(source, target), target_twin = twins(target, source);
   auto redundant = [&](const BallPair& p) {
-    const int i2 = source_twin[static_cast<size_t>(p.source)], j2 = target_twin[static_cast<size_t>(p.target)];
-    return i2 >= 0 && j2 >= 0 && i2 != p.target;
+    const Ball& a = source[static_cast<size_t>(p.source)];
+    const Ball& b = target[static_cast<size_t>(p.target)];
+    const bool same = a.center == b.center && a.weight == b.weight;
+    return source_twin[static_cast<size_t>(p.source)] >= 0 && target_twin[static_cast<size_t>(p.target)] >= 0 && !same;
   };
   Regular overlay;
   std::unordered_set<long> seen;

@@ -165,3 +165,35 @@ TEST_CASE("with_balls into a complex moved before: every cell and ball as a fres
   SkinComplex self = middle;
   CHECK_THROWS_AS(self.with_balls(interpolated_balls(m1, m2, live, 0.3), known, self), ContractError);
 }
+
+TEST_CASE("a side holding the same ball twice: B(t) is that of its distinct balls", "[interpolation][bad]") {
+  // A duplicated atom is the same ball twice; the union, and so the skin,
+  // is that of the distinct balls. The live pairs of pept -> pept with one
+  // atom twice give the skin function of pept -> pept, by the oracle of
+  // docs/math.md section 2, and of the full m*n set's non-hidden balls.
+  const auto pept = test::centred_model(test::data_file("pept.pdb"), 1);
+  std::vector<Ball> twice = pept;
+  twice.push_back(pept[10]);
+  for (const double t : {0.25, 0.5}) {
+    const SkinOracle dup(interpolated_balls(pept, twice, live_pairs(pept, twice), t), 0.5);
+    const SkinOracle plain(interpolated_balls(pept, pept, live_pairs(pept, pept), t), 0.5);
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<size_t> pick(0, pept.size() - 1);
+    std::uniform_real_distribution<double> u(-2.5, 2.5);
+    for (int k = 0; k < 2000; ++k) {
+      const Eigen::Vector3d x = pept[pick(rng)].center + Eigen::Vector3d(u(rng), u(rng), u(rng));
+      const OracleResult a = dup.evaluate(x), b = plain.evaluate(x);
+      REQUIRE(a.certified);
+      REQUIRE(b.certified);
+      CHECK(std::abs(a.value - b.value) <= 1e-9 * std::max(1.0, std::abs(b.value)));
+    }
+  }
+  // One ball onto the same ball twice (and back): B(t) is that ball.
+  const std::vector<Ball> one{{Eigen::Vector3d(1, 2, 3), 4.0}}, two{one[0], one[0]};
+  for (const auto& [from, to] : {std::pair{one, two}, std::pair{two, one}}) {
+    const std::vector<Ball> b = interpolated_balls(from, to, live_pairs(from, to), 0.5);
+    REQUIRE(b.size() == 1);
+    CHECK(b[0].center == one[0].center);
+    CHECK(b[0].weight == one[0].weight);
+  }
+}
