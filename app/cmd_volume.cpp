@@ -31,7 +31,11 @@ struct VolumeCommandOptions {
   std::string output, report;
   MeshingOptions meshing;
   double max_memory_gb = 0;  // 0: the memory available when the command starts
-  VolumeOptions volume;
+  VolumeOptions volume = [] {
+    VolumeOptions v;
+    v.max_seconds = 3600;  // an hour: quality bounds near their limits can keep TetGen's refinement going for good
+    return v;
+  }();
   std::string domain = "interior";
   bool drop_cavities = false;
 };
@@ -65,8 +69,11 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
       ->capture_default_str();
   cmd.add_option("--edge-length", o.meshing.edge_length, "surface: largest edge length, A (0: none, curvature only)")->check(finite_number())->check(non_negative_number())->capture_default_str();
   cmd.add_option("--max-memory", o.max_memory_gb,
-                 "surface: refuse at once a skin mesh whose estimated memory passes this many GB (0: the memory "
-                 "available now)")
+                 "refuse at once a skin mesh whose estimated memory passes this many GB, and stop TetGen past it "
+                 "(0: the memory available now)")
+      ->check(finite_number())->check(non_negative_number())
+      ->capture_default_str();
+  cmd.add_option("--max-seconds", o.volume.max_seconds, "stop TetGen past this many seconds (0: no bound)")
       ->check(finite_number())->check(non_negative_number())
       ->capture_default_str();
 }
@@ -160,7 +167,8 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
               << json_text(guarantees_json(g)) << "\n";
     return ExitCode::not_met;
   }
-  const VolumeOptions volume = volume_options(o);
+  VolumeOptions volume = volume_options(o);
+  volume.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
   if (progress) std::cerr << "skinmesh: " << surface.mesh.triangles.size() << " skin triangles; running TetGen\n";
   const VolumeMeshResult made = tetrahedralize(surface.mesh, volume);
   if (made.status != VolumeStatus::ok) {

@@ -982,3 +982,18 @@ TEST_CASE("a file name as long as the file system allows is written; a killed ru
   CHECK(std::filesystem::exists(alive));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("volume is bounded: TetGen's memory by --max-memory, its run and clean-up by --max-seconds", "[cli][bad][volume]") {
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  skinmesh::test::TempFile holder("x");
+  const std::string stem = holder.path() + "-bounded";
+  // A box 300 A out takes TetGen about 1.2 GB; 0.3 GB are allowed.
+  const Run memory = run("--quiet volume " + pept + " -o " + stem + " --domain both --box-margin 300 --max-memory 0.3");
+  CHECK(memory.code == 3);
+  CHECK(memory.output.find("out of the memory allowed (0.300 GB, --max-memory)") != std::string::npos);
+  // Bounds at the ends of their ranges keep the clean-up going for minutes; 2 s are allowed.
+  const Run time = run("--quiet volume " + pept + " -o " + stem + " --min-dihedral 16 --max-radius-edge 1 --max-seconds 2");
+  CHECK(time.code == 3);
+  CHECK(time.output.find("past the time allowed (2 s, --max-seconds)") != std::string::npos);
+  for (const char* ext : {".vtu", ".msh", ".node", ".ele", ".face"}) CHECK_FALSE(std::filesystem::exists(stem + ext));
+}

@@ -19,7 +19,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <functional>
+#include <optional>
 #include <set>
 
 namespace skinmesh {
@@ -82,6 +84,14 @@ class Improver {
 
   // The free points of the bad tetrahedra (and, with their_stars, those of
   // their vertices' stars) optimised once each. Returns how many moved.
+  // The time bound: past `deadline` (steady clock) every pass stops.
+  void set_deadline(double max_seconds) {
+    if (max_seconds > 0)
+      deadline_ = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                          std::chrono::duration<double>(max_seconds));
+  }
+  bool late() const { return deadline_ && std::chrono::steady_clock::now() > *deadline_; }
+
   long smooth(const std::vector<int>& bad, SmoothingReach reach) {
     const bool wide = reach == SmoothingReach::their_stars;
     std::set<int> work;
@@ -94,11 +104,13 @@ class Improver {
               if (!fixed_[static_cast<size_t>(u)]) work.insert(u);
       }
     long moved = 0;
-    for (int v : work)
+    for (int v : work) {
+      if (late()) break;
       if (optimise_point(v)) {
         ++moved;
         changed_.insert(changed_.end(), star_[static_cast<size_t>(v)].begin(), star_[static_cast<size_t>(v)].end());
       }
+    }
     return moved;
   }
 
@@ -328,13 +340,15 @@ class Improver {
   std::vector<std::vector<int>> star_;
   std::vector<char> fixed_;
   std::set<std::pair<int, int>> marked_edges_;
+  std::optional<std::chrono::steady_clock::time_point> deadline_;
   std::vector<int> changed_;  // tetrahedra changed since bad_tets() last looked
 };
 
 }  // namespace
 
-TetImprovement improve_tet_mesh(TetMesh& mesh, const TetBounds& bounds) {
+TetImprovement improve_tet_mesh(TetMesh& mesh, const TetBounds& bounds, double max_seconds) {
   Improver improver(mesh, bounds);
+  improver.set_deadline(max_seconds);
   TetImprovement result;
   std::vector<int> bad = improver.all_bad_tets();
   result.bad_before = static_cast<long>(bad.size());
@@ -346,11 +360,16 @@ TetImprovement improve_tet_mesh(TetMesh& mesh, const TetBounds& bounds) {
     result.moved += improver.smooth(bad, round >= 2 ? SmoothingReach::their_stars : SmoothingReach::bad_tets);
     bad = improver.bad_tets(bad);
     if (round >= 1) {
-      for (int t : bad) result.flips += improver.remove_an_edge(t);
+      for (int t : bad) {
+        if (improver.late()) break;
+        result.flips += improver.remove_an_edge(t);
+      }
       bad = improver.bad_tets(bad);
     }
     if (round >= 3 && bad.size() >= before) break;
+    if (improver.late()) break;
   }
+  result.timed_out = improver.late();
   improver.compact();
   result.bad_after = static_cast<long>(improver.all_bad_tets().size());
   return result;

@@ -2,11 +2,14 @@
 #include "tetgen_run.hpp"
 
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <csignal>
 #include <cstring>
 #include <new>
 
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -85,9 +88,33 @@ bool send(int fd, const T* data, long count) {
 // In the child: run TetGen, send its exit code (0: finished) and, when it
 // finished, points, tetrahedra, one region per tetrahedron, faces, face
 // markers; then end without running the parent's atexit handlers.
-[[noreturn]] void tetgen_child(int fd, const Plc& plc, const std::string& switches, pid_t parent) {
+// The child's address space may grow by the memory bound (its copy of the
+// caller's counts already), and SIGALRM ends it at the time bound.
+void limit_child(const TetgenLimits& limits) {
+  if (limits.max_memory_bytes > 0) {
+    long pages = 0;
+    if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
+      if (std::fscanf(statm, "%ld", &pages) != 1) pages = 0;
+      std::fclose(statm);
+    }
+    const double size = static_cast<double>(pages) * static_cast<double>(::sysconf(_SC_PAGESIZE)) + limits.max_memory_bytes;
+    struct rlimit bound {};
+    if (::getrlimit(RLIMIT_AS, &bound) == 0 && (bound.rlim_cur == RLIM_INFINITY || static_cast<double>(bound.rlim_cur) > size)) {
+      bound.rlim_cur = static_cast<rlim_t>(size);
+      ::setrlimit(RLIMIT_AS, &bound);
+    }
+  }
+  if (limits.max_seconds > 0) {
+    std::signal(SIGALRM, SIG_DFL);
+    ::alarm(static_cast<unsigned>(std::ceil(limits.max_seconds)));
+  }
+}
+
+[[noreturn]] void tetgen_child(int fd, const Plc& plc, const std::string& switches, pid_t parent,
+                               const TetgenLimits& limits) {
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the caller (an interrupt ends it)
   if (::getppid() != parent) ::_exit(1);  // the caller ended before the line above took effect
+  limit_child(limits);
   // A crash ends the child plainly: handlers the caller installed (a test
   // framework's, say) are not the child's to run.
   for (int sig : {SIGSEGV, SIGABRT, SIGBUS, SIGFPE, SIGILL}) std::signal(sig, SIG_DFL);
@@ -187,7 +214,7 @@ TetgenRun unpack(const std::vector<char>& bytes) {
 
 }  // namespace
 
-TetgenRun run_tetgen(const Plc& plc, const std::string& switches) {
+TetgenRun run_tetgen(const Plc& plc, const std::string& switches, const TetgenLimits& limits) {
   TetgenRun run;
   int fds[2];
   if (::pipe(fds) != 0) {
@@ -204,7 +231,7 @@ TetgenRun run_tetgen(const Plc& plc, const std::string& switches) {
   }
   if (child == 0) {
     ::close(fds[0]);
-    tetgen_child(fds[1], plc, switches, parent);
+    tetgen_child(fds[1], plc, switches, parent, limits);
   }
   ::close(fds[1]);
   const std::vector<char> bytes = read_until_closed(fds[0]);
@@ -214,7 +241,13 @@ TetgenRun run_tetgen(const Plc& plc, const std::string& switches) {
   }
   int code = -1;
   if (bytes.size() >= sizeof code) std::memcpy(&code, bytes.data(), sizeof code);
-  if (code > 0) run.error = tetgen_error(code);
+  if (code == 1 && limits.max_memory_bytes > 0)
+    run.error = "TetGen ran out of the memory allowed (" + std::to_string(limits.max_memory_bytes / 1e9).substr(0, 5) +
+                " GB, --max-memory)";
+  else if (code > 0) run.error = tetgen_error(code);
+  else if (WIFSIGNALED(status) && WTERMSIG(status) == SIGALRM)
+    run.error = "TetGen ran past the time allowed (" + std::to_string(static_cast<long>(std::ceil(limits.max_seconds))) +
+                " s, --max-seconds)";
   else if (WIFSIGNALED(status))
     run.error = "TetGen crashed (signal " + std::to_string(WTERMSIG(status)) + ", " + strsignal(WTERMSIG(status)) +
                 "), as TetGen 1.5.0 does when it stops on an error in its input";

@@ -41,8 +41,16 @@ struct TetgenRun {
   TetMesh mesh;       // its points, tetrahedra (as TetGen orients them), first region attribute, boundary faces
 };
 
+// Bounds on TetGen's child: the memory it may take beyond what it starts
+// with (its address space), and its run time; 0: none. Past them TetGen
+// stops with an error that says which bound.
+struct TetgenLimits {
+  double max_memory_bytes = 0;
+  double max_seconds = 0;
+};
+
 // tetrahedralize(switches, plc) (switches without '-', always with z:
 // zero-based). With d, the faces are those TetGen found meeting another.
-TetgenRun run_tetgen(const Plc& plc, const std::string& switches);
+TetgenRun run_tetgen(const Plc& plc, const std::string& switches, const TetgenLimits& limits = {});
 
 }  // namespace skinmesh::detail

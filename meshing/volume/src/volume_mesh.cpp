@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -247,7 +248,8 @@ std::string tetgen_switches(const VolumeOptions& options) {
 // Runs TetGen on the complex and takes its tetrahedra, every one
 // positively oriented.
 VolumeMeshResult run_tetgen(const Plc& plc, const VolumeOptions& options) {
-  detail::TetgenRun run = detail::run_tetgen(plc, tetgen_switches(options));
+  detail::TetgenRun run =
+      detail::run_tetgen(plc, tetgen_switches(options), {options.max_memory_bytes, options.max_seconds});
   if (!run.error.empty())
     return failed(VolumeStatus::tetgen_failed, run.error + " (switches " + tetgen_switches(options) + ")");
   VolumeMeshResult result;
@@ -292,6 +294,7 @@ VolumeMeshResult tetrahedralize(const SurfaceMesh& surface, const VolumeOptions&
   const std::string missing = add_surface(surface, options, plc);
   if (!missing.empty()) return failed(VolumeStatus::surface_not_closed, missing);
   if (options.domain != VolumeDomain::interior) add_box(options.box_margin, plc);
+  const auto started = std::chrono::steady_clock::now();
   VolumeMeshResult result = run_tetgen(plc, options);
   // TetGen's commonest input error, named (checked only when it failed).
   if (result.status == VolumeStatus::tetgen_failed) {
@@ -300,7 +303,18 @@ VolumeMeshResult tetrahedralize(const SurfaceMesh& surface, const VolumeOptions&
       result.message += "; the surface intersects itself (" + std::to_string(crossing) + " triangle pairs, CGAL exact)";
   }
   // The few tetrahedra TetGen leaves outside the bounds next to the surface.
-  if (result.status == VolumeStatus::ok) result.improvement = improve_tet_mesh(result.mesh, options.bounds);
+  if (result.status != VolumeStatus::ok) return result;
+  double left = 0;  // of the time bound, after TetGen
+  if (options.max_seconds > 0) {
+    left = options.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (left <= 0) left = 1e-9;
+  }
+  result.improvement = improve_tet_mesh(result.mesh, options.bounds, left);
+  if (result.improvement.timed_out)
+    return failed(VolumeStatus::tetgen_failed,
+                  "the clean-up of TetGen's tetrahedra ran past the time allowed (" +
+                      std::to_string(static_cast<long>(std::ceil(options.max_seconds))) + " s, --max-seconds) with " +
+                      std::to_string(result.improvement.bad_after) + " tetrahedra still outside the bounds");
   return result;
 }
 

@@ -18,8 +18,11 @@ struct TetImprovement {
   long bad_before = 0, bad_after = 0;  // tetrahedra outside the bounds
   long moved = 0;                      // points moved
   long flips = 0;                      // edges removed (ring of tetrahedra retriangulated)
+  bool timed_out = false;              // stopped at max_seconds with bad_after left
 };
 
-TetImprovement improve_tet_mesh(TetMesh& mesh, const TetBounds& bounds = {});
+// max_seconds: the time it may take (0: no bound); past it the mesh is
+// left as the improvement has it, valid, with timed_out set.
+TetImprovement improve_tet_mesh(TetMesh& mesh, const TetBounds& bounds = {}, double max_seconds = 0);
 
 }  // namespace skinmesh

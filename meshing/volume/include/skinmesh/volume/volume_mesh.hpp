@@ -28,6 +28,11 @@ struct VolumeOptions {
   // tetrahedra than this: the domain's volume / max_volume is a lower bound
   // of their number. About 10^7 tetrahedra take TetGen a few GB.
   long max_tetrahedra = 10'000'000;
+  // TetGen's run, bounded: the memory it may take (bytes) and its time
+  // (seconds); past either it stops with status tetgen_failed and a message
+  // naming the bound. 0: none.
+  double max_memory_bytes = 0;
+  double max_seconds = 0;
 };
 
 enum class VolumeStatus {
