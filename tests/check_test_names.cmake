@@ -1,0 +1,11 @@
+# Fails when a Catch2 test case name holds a ';' (tests/CMakeLists.txt says why).
+execute_process(COMMAND ${TESTS} --list-test-names-only OUTPUT_VARIABLE names RESULT_VARIABLE code)
+if(NOT code EQUAL 0 AND names STREQUAL "")
+  message(FATAL_ERROR "cannot list the test cases of ${TESTS}")
+endif()
+string(FIND "${names}" ";" at)
+if(NOT at EQUAL -1)
+  string(SUBSTRING "${names}" 0 ${at} before)
+  string(REGEX REPLACE ".*\n" "" line "${before}")
+  message(FATAL_ERROR "a test case name holds ';', which ctest splits: ${line};...")
+endif()
