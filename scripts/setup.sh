@@ -22,10 +22,19 @@ packages=(
   pybind11-dev python3-dev python3-numpy            # the Python module (docs/python.md)
   python3-pytest python3-meshio python3-mdanalysis  # its tests: pytest, meshio, MD trajectories
   snakemake                                         # many structures: workflows/Snakefile (docs/batch.md)
+  chromium chromium-driver ffmpeg python3-pymol     # viewer tests (headless), movies, PyMOL reads our output
 )
+# Node.js runs the browser and glTF tests' tools (tests/js); a Node.js installed
+# some other way is used as it is.
+command -v npm >/dev/null || packages+=(nodejs npm)
 
 source "$here/scripts/install-packages.sh"
 [ "${SKINMESH_SKIP_INSTALL:-0}" != 1 ] && install_packages "${packages[@]}"
+
+# The test tools from npm, at the versions tests/js/package-lock.json pins.
+if [ "${SKINMESH_SKIP_INSTALL:-0}" != 1 ]; then
+  npm ci --prefix "$here/tests/js" --no-audit --no-fund --loglevel=error
+fi
 
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
