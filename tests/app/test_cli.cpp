@@ -44,6 +44,21 @@ Run run(const std::string& args) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
+// As run(), under a limit of `cpu_seconds` of CPU time: a run that stalls is
+// killed (SIGXCPU) and reports code -1.
+Run run_within(int cpu_seconds, const std::string& args) {
+  const std::string command =
+      "ulimit -t " + std::to_string(cpu_seconds) + "; exec " + std::string(SKINMESH_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string output;
+  std::array<char, 4096> buffer{};
+  size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
 }  // namespace
 
 TEST_CASE("skinmesh info reports atoms, radii and the complex", "[cli]") {
@@ -440,6 +455,31 @@ TEST_CASE("an empty skin is said to be empty, and non-UTF-8 names do not break -
   REQUIRE(start != std::string::npos);
   const nlohmann::json j = nlohmann::json::parse(r.output.substr(start));
   CHECK(j["molecule"].get<std::string>().find("\xef\xbf\xbd") != std::string::npos);  // U+FFFD
+}
+
+// B(1e-5) of pept -> 3al1 holds clusters of balls 1e-5 to 1e-3 A apart
+// (pair (i, j) lies t |z_i - z_j| from z_i). The frame took minutes, walks
+// along segments creeping through their sliver cells 1e-9 at a time; it
+// takes about 2 s of CPU. A stall is killed at 60.
+TEST_CASE("morph a step of 1e-5 in t from pept to 3al1 in bounded time", "[cli][morph][bad]") {
+  char pattern[] = "/tmp/skinmesh-near-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = std::string(pattern) + "/out";
+  const Run r = run_within(60, "morph " + skinmesh::test::data_file("pept.pdb") + " " +
+                                   skinmesh::test::data_file("3al1.pdb") + " --t 0,0.00001 --format ply -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  std::ifstream jsonl(dir + "/frames.jsonl");
+  std::string line;
+  int frames = 0;
+  while (std::getline(jsonl, line)) {
+    const nlohmann::json f = nlohmann::json::parse(line);
+    CHECK(f["min_angle"].get<double>() >= 20.0);
+    CHECK(f["max_onsurf_error"].get<double>() <= 1e-9);
+    ++frames;
+  }
+  CHECK(frames == 2);
+  std::filesystem::remove_all(pattern);
 }
 
 TEST_CASE("skinmesh morph writes a self-describing directory of checked frames", "[cli][morph]") {
