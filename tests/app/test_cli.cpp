@@ -1,5 +1,6 @@
 // The skinmesh command: exit codes and messages a user sees.
 #include "cgal_reference.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 #include "skinmesh/core/interpolation.hpp"
@@ -25,26 +26,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace {
-
-struct Run {
-  int code;
-  std::string output;  // stdout and stderr together
-};
-
-Run run(const std::string& args) {
-  const std::string command = std::string(SKINMESH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string output;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
-}  // namespace
+using skinmesh::test::Run;
+using skinmesh::test::run;
 
 TEST_CASE("skinmesh info reports atoms, radii and the complex", "[cli]") {
   const Run r = run("info " + skinmesh::test::data_file("pept.pdb"));
@@ -463,7 +446,8 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   std::ifstream ply(dir + "/frame_0002.ply");
   std::string header, line;
   while (std::getline(ply, line) && line != "end_header") header += line + "\n";
-  for (const char* property : {"property int id", "property int source_atom", "property int target_atom"})
+  for (const char* property : {"property int id", "property uint atomid", "property uint source_atom",
+                               "property uchar has_source_atom", "property uint target_atom", "property uchar has_target_atom"})
     CHECK(header.find(property) != std::string::npos);
   // frames.jsonl: one object per frame with the fields a user plots.
   std::ifstream jsonl(dir + "/frames.jsonl");
