@@ -146,7 +146,8 @@ TEST_CASE("an XYZR molecule's atom table leaves residues and elements empty", "[
   fs::remove_all(dir);
 }
 
-TEST_CASE("--ascii is a PLY's option: with another format it is refused and nothing is written", "[cli][atoms][bad]") {
+TEST_CASE("a text PLY is PLY's alone: --ascii with another format is refused and nothing is written",
+          "[cli][atoms][bad]") {
   const std::string dir = temp_dir();
   const auto r = run("mesh " + test::data_file("pept.pdb") + " --ascii -o " + dir + "/pept.off");
   CHECK(r.code == 2);

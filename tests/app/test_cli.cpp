@@ -948,10 +948,18 @@ TEST_CASE("a file name as long as the file system allows is written, and a kille
   char pattern[] = "/tmp/skinmesh-names-XXXXXX";
   REQUIRE(mkdtemp(pattern) != nullptr);
   const std::string dir = pattern;
-  const std::string longest = dir + "/" + std::string(251, 'm') + ".ply";  // a 255-byte name
+  // The longest output is the atom table beside the mesh: a 255-byte name.
+  const std::string longest = dir + "/" + std::string(245, 'm') + ".ply";
   const Run r = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + longest);
   CHECK(r.code == 0);
   CHECK(std::filesystem::exists(longest));
+  CHECK(std::filesystem::exists(dir + "/" + std::string(245, 'm') + ".atoms.tsv"));
+  // One byte more is refused before the work, naming the table, and nothing is written.
+  const std::string over = dir + "/" + std::string(246, 'n') + ".ply";
+  const Run refused = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + over);
+  CHECK(refused.code == 2);
+  CHECK(refused.output.find(std::string(246, 'n') + ".atoms.tsv: is a longer name") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(over));
   // Staging files: one of a process that is gone, one of this (living) process.
   const pid_t gone = fork();
   REQUIRE(gone >= 0);
