@@ -1,5 +1,6 @@
 // The skinmesh command: exit codes and messages a user sees.
 #include "cgal_reference.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 #include "skinmesh/core/interpolation.hpp"
@@ -25,41 +26,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace {
-
-struct Run {
-  int code;
-  std::string output;  // stdout and stderr together
-};
-
-Run run(const std::string& args) {
-  const std::string command = std::string(SKINMESH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string output;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
-// As run(), under a limit of `cpu_seconds` of CPU time: a run that stalls is
-// killed (SIGXCPU) and reports code -1.
-Run run_within(int cpu_seconds, const std::string& args) {
-  const std::string command =
-      "ulimit -t " + std::to_string(cpu_seconds) + "; exec " + std::string(SKINMESH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string output;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
-}  // namespace
+using skinmesh::test::Run;
+using skinmesh::test::run;
+using skinmesh::test::run_within;
 
 TEST_CASE("skinmesh info reports atoms, radii and the complex", "[cli]") {
   const Run r = run("info " + skinmesh::test::data_file("pept.pdb"));
@@ -503,7 +472,8 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   std::ifstream ply(dir + "/frame_0002.ply");
   std::string header, line;
   while (std::getline(ply, line) && line != "end_header") header += line + "\n";
-  for (const char* property : {"property int id", "property int source_atom", "property int target_atom"})
+  for (const char* property : {"property int id", "property uint atomid", "property uint source_atom",
+                               "property uchar has_source_atom", "property uint target_atom", "property uchar has_target_atom"})
     CHECK(header.find(property) != std::string::npos);
   // frames.jsonl: one object per frame with the fields a user plots.
   std::ifstream jsonl(dir + "/frames.jsonl");
@@ -1004,10 +974,18 @@ TEST_CASE("a file name as long as the file system allows is written, and a kille
   char pattern[] = "/tmp/skinmesh-names-XXXXXX";
   REQUIRE(mkdtemp(pattern) != nullptr);
   const std::string dir = pattern;
-  const std::string longest = dir + "/" + std::string(251, 'm') + ".ply";  // a 255-byte name
+  // The longest output is the atom table beside the mesh: a 255-byte name.
+  const std::string longest = dir + "/" + std::string(245, 'm') + ".ply";
   const Run r = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + longest);
   CHECK(r.code == 0);
   CHECK(std::filesystem::exists(longest));
+  CHECK(std::filesystem::exists(dir + "/" + std::string(245, 'm') + ".atoms.tsv"));
+  // One byte more is refused before the work, naming the table, and nothing is written.
+  const std::string over = dir + "/" + std::string(246, 'n') + ".ply";
+  const Run refused = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + over);
+  CHECK(refused.code == 2);
+  CHECK(refused.output.find(std::string(246, 'n') + ".atoms.tsv: is a longer name") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(over));
   // Staging files: one of a process that is gone, one of this (living) process.
   const pid_t gone = fork();
   REQUIRE(gone >= 0);
