@@ -140,6 +140,18 @@ void print_volume_summary(const VolumeCommandOptions& o, const VolumeOptions& vo
             << report["enclosed_volume"].get<double>() << " A^3\n";
 }
 
+// The five volume files and the report, all or none.
+void write_volume_files(const VolumeCommandOptions& o, const TetMesh& mesh, const json& report) {
+  OutputSet outputs;
+  outputs.add(o.output + ".vtu", [&](std::ostream& out) { write_vtu(out, mesh); });
+  outputs.add(o.output + ".msh", [&](std::ostream& out) { write_gmsh(out, mesh); });
+  outputs.add(o.output + ".node", [&](std::ostream& out) { write_tetgen_node(out, mesh); });
+  outputs.add(o.output + ".ele", [&](std::ostream& out) { write_tetgen_ele(out, mesh); });
+  outputs.add(o.output + ".face", [&](std::ostream& out) { write_tetgen_face(out, mesh); });
+  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << json_text(report) << "\n"; });
+  outputs.commit();
+}
+
 // The outer box alone, before the skin is meshed: the atoms' centres lie
 // inside the skin, so their bounding box is inside the skin's, and the box's
 // estimate without the skin's triangles or the volume bound is a low end of
@@ -203,14 +215,7 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   const TetQuality q = grade_tet_mesh(made.mesh);
   const long tetgen_triangles = tetgen_self_intersections(surface.mesh);
   const json report = volume_report(o, volume, made, q, g.quality, tetgen_triangles);
-  OutputSet outputs;
-  outputs.add(o.output + ".vtu", [&](std::ostream& out) { write_vtu(out, made.mesh); });
-  outputs.add(o.output + ".msh", [&](std::ostream& out) { write_gmsh(out, made.mesh); });
-  outputs.add(o.output + ".node", [&](std::ostream& out) { write_tetgen_node(out, made.mesh); });
-  outputs.add(o.output + ".ele", [&](std::ostream& out) { write_tetgen_ele(out, made.mesh); });
-  outputs.add(o.output + ".face", [&](std::ostream& out) { write_tetgen_face(out, made.mesh); });
-  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << json_text(report) << "\n"; });
-  outputs.commit();
+  write_volume_files(o, made.mesh, report);
   if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet) print_volume_summary(o, volume, q, report);
   return ExitCode::ok;

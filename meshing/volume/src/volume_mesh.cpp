@@ -204,6 +204,14 @@ VolumeMeshResult failed(VolumeStatus status, std::string message) {
   return r;
 }
 
+// What keeps a surface from bounding a volume.
+std::string not_closed(const MeshQuality& q) {
+  return "the surface is not a closed, consistently oriented manifold (" + std::to_string(q.boundary_edges) +
+         " boundary, " + std::to_string(q.nonmanifold_edges) + " non-manifold and " +
+         std::to_string(q.inconsistent_edges) + " inconsistently oriented edges, " +
+         std::to_string(q.nonmanifold_vertices) + " non-manifold vertices)";
+}
+
 // TetGen's switches: -p a piecewise linear complex; -z zero-based; -A region
 // attributes; -Y no Steiner points on the surface; -Q quiet; -q quality bounds.
 // TetGen cannot split a tetrahedron whose refinement point would land on the
@@ -259,12 +267,7 @@ VolumeMeshResult tetrahedralize(const SurfaceMesh& surface, const VolumeOptions&
   GradeOptions topology_only;
   topology_only.self_intersections = SelfIntersectionCheck::skip;
   const MeshQuality q = grade_mesh(surface, topology_only);
-  if (!(q.closed && q.manifold && q.oriented))
-    return failed(VolumeStatus::surface_not_closed,
-                  "the surface is not a closed, consistently oriented manifold (" + std::to_string(q.boundary_edges) +
-                      " boundary, " + std::to_string(q.nonmanifold_edges) + " non-manifold and " +
-                      std::to_string(q.inconsistent_edges) + " inconsistently oriented edges, " +
-                      std::to_string(q.nonmanifold_vertices) + " non-manifold vertices)");
+  if (!(q.closed && q.manifold && q.oriented)) return failed(VolumeStatus::surface_not_closed, not_closed(q));
   const TetDomain domain = tet_domain(surface, q.volume);
   const std::string too_many = tet_budget_refusal(domain, options);
   if (!too_many.empty()) return failed(VolumeStatus::over_budget, too_many);
