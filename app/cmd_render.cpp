@@ -1,10 +1,12 @@
 // skinmesh render: a PNG picture of a molecule's skin (meshed first, coloured
-// by patch type, element or chain) or of any mesh file, without a display.
+// by patch type, element or chain) or of any mesh file, or a movie of a
+// morph directory (render_movie.hpp), without a display.
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
+#include "render_movie.hpp"
 
 #include "skinmesh/core/balls.hpp"
 #include "skinmesh/core/error.hpp"
@@ -15,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -29,18 +32,26 @@ struct RenderCommandOptions {
   std::string output;
   std::string colour = "patch";
   RenderOptions view;
+  MovieOptions movie;  // with --movie: its path, length and rate
 };
 
 void add_render_options(CLI::App& cmd, RenderCommandOptions& o) {
   cmd.add_option("input", o.molecule.path,
-                 "a molecule (meshed with the defaults of `mesh`), or a mesh file (.ply .off .obj .stl .msh .vert)")
+                 "a molecule (meshed with the defaults of `mesh`), a mesh file (.ply .off .obj .stl .msh .vert), or a "
+                 "morph directory (with --movie)")
       ->required();
   add_molecule_settings(cmd, o.molecule);
-  cmd.add_option("--output,-o", o.output, "PNG file")->required();
+  cmd.add_option("--output,-o", o.output, "PNG file (a molecule or a mesh file)");
+  cmd.add_option("--movie", o.movie.path,
+                 "a morph directory's movie: .mp4 (H.264) or .webm (VP9), made by ffmpeg; ids interpolated between "
+                 "frames");
+  cmd.add_option("--seconds", o.movie.seconds, "the movie's length")->check(finite_number())->check(CLI::Range(0.04, 3600.0));
+  cmd.add_option("--fps", o.movie.fps, "the movie's pictures a second")->check(finite_number())->check(CLI::Range(1.0, 120.0));
   cmd.add_option("--colour,--color", o.colour,
                  "a molecule's vertices by patch (sphere, saddle, concave), element, chain, or uniform; a mesh file "
-                 "is uniform")
-      ->check(CLI::IsMember({"patch", "element", "chain", "uniform"}));
+                 "is uniform; a movie by patch, age (frames its id has lived), uniform, or chain or element (from "
+                 "the morph's atom tables)")
+      ->check(CLI::IsMember({"patch", "element", "chain", "uniform", "age"}));
   cmd.add_option("--width", o.view.width, "pixels")->check(CLI::Range(16, 8192));
   cmd.add_option("--height", o.view.height, "pixels")->check(CLI::Range(16, 8192));
   cmd.add_option("--yaw", o.view.yaw, "degrees about the vertical axis")->check(finite_number());
@@ -98,7 +109,30 @@ SurfaceMesh molecule_mesh(const RenderCommandOptions& o, std::vector<Colour>& co
   return std::move(made.mesh);
 }
 
+ExitCode run_movie(const RenderCommandOptions& o, const GlobalOptions& global) {
+  if (!o.output.empty()) contract_error("render: give --movie or --output, not both");
+  MovieOptions movie = o.movie;
+  movie.colour = o.colour;
+  movie.view = o.view;
+  check_movie(movie, o.molecule.path);
+  check_writable({movie.path});
+  const MovieSummary made = write_movie(movie, o.molecule.path);
+  const json report = {{"input", o.molecule.path}, {"movie", movie.path},     {"width", o.view.width},
+                       {"height", o.view.height},  {"pictures", made.pictures}, {"fps", movie.fps},
+                       {"frames", made.frames},     {"encoder", made.encoder}, {"colour", movie.colour}};
+  if (global.json) std::cout << json_text(report) << "\n";
+  else if (!global.quiet)
+    std::cout << movie.path << ": " << made.pictures << " pictures of " << o.view.width << " x " << o.view.height << " ("
+              << made.encoder << "), " << made.frames << " frames of the morph\n";
+  return ExitCode::ok;
+}
+
 ExitCode run_render(const RenderCommandOptions& o, const GlobalOptions& global) {
+  if (!o.movie.path.empty()) return run_movie(o, global);
+  if (o.output.empty()) contract_error("render: --output (a PNG) is required, or --movie for a morph directory");
+  if (std::filesystem::is_directory(o.molecule.path))
+    contract_error("render: " + o.molecule.path + " is a directory: a morph's is drawn with --movie OUT.mp4");
+  if (o.colour == "age") contract_error("render: --colour age is a morph's (with --movie)");
   check_writable({o.output});
   std::vector<Colour> colours;
   const SurfaceMesh mesh = is_mesh_file(o.molecule.path) ? read_surface_mesh(o.molecule.path) : molecule_mesh(o, colours);
