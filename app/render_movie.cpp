@@ -119,7 +119,7 @@ void colour_frames(std::vector<MovieFrame>& frames, std::vector<std::map<std::st
       }
       Colour c = o.view.colour;
       if (o.colour == "patch" && p.count("patch")) c = by_patch[std::clamp(static_cast<int>(p.at("patch")[v]), 0, 3)];
-      else if (o.colour == "age") c = ramp(1 - (age[v] - 1) / std::max(1.0, static_cast<double>(frames.size() - 1)));
+      else if (o.colour == "age") c = ramp((age[v] - 1) / std::max(1.0, static_cast<double>(frames.size() - 1)));  // new red, old blue-green
       else if (o.colour == "chain" || o.colour == "element") {
         c = {0.55f, 0.55f, 0.58f};
         for (const char* side : {"source", "target"}) {

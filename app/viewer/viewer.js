@@ -314,7 +314,7 @@
                vertex: (f, i, side) => tableColour(f, i, side, (T, k) => elementColours[T.atoms[k].element] || [0.85, 0.55, 0.85]) },
     atom: { label: 'atom index', vertex: (f, i, side) => { const k = vertexAtom(f, i, side).index; return k < 0 ? noColour : distinct(k); } },
     patch: { label: 'patch type', vertex: (f, i) => (f.patch ? patchColours[f.patch[i]] || noColour : noColour) },
-    age: { label: 'vertex age', morph: true, vertex: (f, i) => ramp(1 - (f.age[i] - 1) / Math.max(1, scene.frames.length - 1)) },
+    age: { label: 'vertex age', morph: true, vertex: (f, i) => ramp((f.age[i] - 1) / Math.max(1, scene.frames.length - 1)) },
     quality: { label: 'triangle quality (smallest angle)', triangle: (f, k) => ramp(f.minAngle[k] / 60) },
   };
 
@@ -471,23 +471,49 @@
   }
 
   // The camera: turned by yaw about the vertical axis, then by pitch about
-  // the horizontal one (as skinmesh render), the molecule's bounding sphere
-  // filling the picture's smaller side at zoom 1.
+  // the horizontal one (as skinmesh render), at the distance that frames the
+  // molecule at zoom 1 (fitDistance).
   const fov = 30 * Math.PI / 180;
   function camera(state, width, height) {
-    const { centre, radius } = scene.bounds;
     // On a wide canvas the molecule is framed in the part the panel leaves.
     const ratio = width / canvas.clientWidth;
     const panel = canvas.clientWidth > 640 ? ($('panel').offsetWidth + 24) * ratio : 0;
     const aspect = width / height, free = (width - panel) / height;
-    const fit = radius / Math.sin(Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * free)) / 2);
-    const distance = fit / state.zoom;
-    const view = multiply(translation(0, 0, -distance),
-                          multiply(rotationX(state.pitch * Math.PI / 180),
-                                   multiply(rotationY(state.yaw * Math.PI / 180), translation(-centre[0], -centre[1], -centre[2]))));
+    const turn = multiply(rotationX(state.pitch * Math.PI / 180), rotationY(state.yaw * Math.PI / 180));
+    if (!scene.fit) scene.fit = fitDistance(multiply(rotationX(defaults.pitch * Math.PI / 180), rotationY(defaults.yaw * Math.PI / 180)), free);
+    const { centre, radius } = scene.bounds;
+    const distance = scene.fit / state.zoom;
+    const view = multiply(translation(0, 0, -distance), multiply(turn, translation(-centre[0], -centre[1], -centre[2])));
     const shift = translation(panel / width, 0, 0);  // in clip space: half the panel's width to the right
     const projection = multiply(shift, perspective(fov, aspect, Math.max(distance - 2 * radius, distance / 100), distance + 2 * radius));
     return { view, projection, viewProjection: multiply(projection, view) };
+  }
+
+  // The centre and the distance at zoom 1: every frame's vertices, seen
+  // from the default view, inside the free part of the picture with 5% to
+  // spare. The same for every view, so that turning does not zoom and a
+  // shared fragment shows the same picture.
+  function fitDistance(turn, aspect) {
+    const seen = (centre, body) => {
+      for (const f of scene.frames)
+        for (let i = 0; i < f.positions.length; i += 3) {
+          const p = [0, 1, 2].map((c) => f.positions[i + c] - centre[c]);
+          body([0, 1, 2].map((r) => turn[r] * p[0] + turn[4 + r] * p[1] + turn[8 + r] * p[2]));
+        }
+    };
+    // First the centre: the middle of the outline in this view.
+    const lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
+    seen(scene.bounds.centre, (q) => { for (const c of [0, 1]) { lo[c] = Math.min(lo[c], q[c]); hi[c] = Math.max(hi[c], q[c]); } });
+    const mid = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2];
+    scene.bounds.centre = scene.bounds.centre.map((v, c) => v + turn[4 * c] * mid[0] + turn[4 * c + 1] * mid[1]);
+    const tanY = Math.tan(fov / 2), tanX = tanY * aspect;
+    let distance = 0;
+    scene.bounds.radius = 1e-6;  // about the new centre
+    seen(scene.bounds.centre, (q) => {
+      scene.bounds.radius = Math.max(scene.bounds.radius, Math.hypot(q[0], q[1], q[2]));
+      distance = Math.max(distance, q[2] + 1.05 * Math.abs(q[0]) / tanX, q[2] + 1.05 * Math.abs(q[1]) / tanY);
+    });
+    return Math.max(distance, 2 * scene.bounds.radius / 10);
   }
 
   // ---------------------------------------------------------------- state and drawing
@@ -575,6 +601,7 @@
       gl.bindVertexArray(d.vao);
       gl.drawArrays(gl.TRIANGLES, 0, d.count);
     });
+    placeMarker(cam.viewProjection);
     showState();
   }
 
@@ -662,6 +689,17 @@
     return out;
   }
 
+  // The picked point's dot, where the point is in this view (kept while the view turns).
+  function placeMarker(viewProjection) {
+    const p = window.skinmeshViewer && window.skinmeshViewer.lastPick, el = $('marker');
+    if (!p) { el.style.display = 'none'; return; }
+    const v = [0, 1, 2, 3].map((r) => viewProjection[r] * p.position[0] + viewProjection[4 + r] * p.position[1] +
+                                       viewProjection[8 + r] * p.position[2] + viewProjection[12 + r]);
+    el.style.left = `${(v[0] / v[3] + 1) / 2 * canvas.clientWidth}px`;
+    el.style.top = `${(1 - v[1] / v[3]) / 2 * canvas.clientHeight}px`;
+    el.style.display = 'block';
+  }
+
   function pickText(p) {
     if (!p) return 'nothing under the pointer';
     const line = (side, a) => {
@@ -689,14 +727,13 @@
     const m = state.colour, el = $('legend');
     const rampCss = `linear-gradient(to right, ${[0, 0.25, 0.5, 0.75, 1].map((x) => `rgb(${ramp(x).map((c) => Math.round(255 * c))})`).join(',')})`;
     if (m === 'quality') el.innerHTML = `<div class="ramp" style="background:${rampCss}"></div><div class="ends"><span>0&deg;</span><span>30&deg;</span><span>60&deg;</span></div>`;
-    else if (m === 'age') el.innerHTML = `<div class="ramp" style="background:${rampCss}"></div><div class="ends"><span>${scene.frames.length} frames old</span><span>new</span></div>`;
+    else if (m === 'age') el.innerHTML = `<div class="ramp" style="background:${rampCss}"></div><div class="ends"><span>new</span><span>${scene.frames.length} frames old</span></div>`;
     else if (m === 'patch') {
       const names = ['sphere (1 atom)', 'hyperboloid (2)', 'hyperboloid (3)', 'concave sphere (4)'];
       el.innerHTML = names.map((n, k) => `<span class="swatch" style="background:rgb(${patchColours[k].map((c) => Math.round(255 * c))})"></span>${n}`).join('<br>');
     } else el.textContent = { chain: 'a hue per chain', residue: 'a hue per residue', 'source-residue': 'a hue per source residue',
                               'target-residue': 'a hue per target residue', element: 'C grey, N blue, O red, S yellow, P orange',
                               atom: 'a hue per atom index' }[m] || '';
-    if (m === 'age') el.querySelector('.ramp').style.transform = 'scaleX(-1)';
   }
 
   function setupControls() {
@@ -747,6 +784,7 @@
         const p = pick(e.clientX - r.left, e.clientY - r.top);
         window.skinmeshViewer.lastPick = p;
         $('pick').textContent = pickText(p);
+        dirty = true;
       }
       drag = null;
     });
