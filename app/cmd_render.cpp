@@ -6,6 +6,7 @@
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
+#include "render_colours.hpp"
 #include "render_movie.hpp"
 
 #include "skinmesh/core/balls.hpp"
@@ -63,22 +64,6 @@ bool is_mesh_file(const std::string& path) {
     if (path.size() > std::string(ext).size() && path.compare(path.size() - std::string(ext).size(), std::string::npos, ext) == 0)
       return true;
   return false;
-}
-
-// A colour per distinct key, from a palette that tells neighbours apart.
-Colour palette(size_t k) {
-  static const Colour colours[] = {{0.38f, 0.62f, 0.85f}, {0.95f, 0.62f, 0.30f}, {0.45f, 0.75f, 0.45f},
-                                   {0.85f, 0.40f, 0.45f}, {0.65f, 0.52f, 0.80f}, {0.70f, 0.60f, 0.45f},
-                                   {0.90f, 0.55f, 0.75f}, {0.60f, 0.60f, 0.60f}};
-  return colours[k % (sizeof colours / sizeof colours[0])];
-}
-
-Colour element_colour(const std::string& element) {  // the usual CPK hues, softened
-  static const std::map<std::string, Colour> known = {{"C", {0.72f, 0.72f, 0.72f}}, {"N", {0.40f, 0.52f, 0.92f}},
-                                                      {"O", {0.92f, 0.38f, 0.35f}}, {"S", {0.95f, 0.85f, 0.35f}},
-                                                      {"P", {0.98f, 0.60f, 0.25f}}, {"H", {0.95f, 0.95f, 0.95f}}};
-  const auto found = known.find(element);
-  return found != known.end() ? found->second : Colour{0.85f, 0.55f, 0.85f};
 }
 
 // The skin of the molecule, meshed, and a colour per vertex.

@@ -2,6 +2,7 @@
 
 #include "interrupt.hpp"
 #include "output_file.hpp"
+#include "render_colours.hpp"
 #include "view_input.hpp"
 
 #include "skinmesh/core/error.hpp"
@@ -73,14 +74,6 @@ std::vector<std::string> table_column(const std::string& path, const std::string
   return out;
 }
 
-Colour hue(size_t k) {  // the k-th of a sequence of hues that tells neighbours apart
-  const double h = std::fmod(static_cast<double>(k) * 0.6180339887, 1.0) * 6;
-  const double x = 1 - std::abs(std::fmod(h, 2.0) - 1);
-  const double rgb[6][3] = {{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}};
-  const auto& c = rgb[static_cast<int>(h) % 6];
-  return {static_cast<float>(0.35 + 0.5 * c[0]), static_cast<float>(0.35 + 0.5 * c[1]), static_cast<float>(0.35 + 0.5 * c[2])};
-}
-
 Colour ramp(double x) {  // 0 red, 1/2 yellow, 1 blue-green, as the viewer's
   const Colour stops[3] = {{0.80f, 0.15f, 0.15f}, {0.97f, 0.85f, 0.30f}, {0.25f, 0.62f, 0.75f}};
   const double u = std::clamp(x, 0.0, 1.0) * 2;
@@ -91,15 +84,10 @@ Colour ramp(double x) {  // 0 red, 1/2 yellow, 1 blue-green, as the viewer's
   return c;
 }
 
-// The atom of a vertex on the source side, else the target side, or -1
-// (a side the vertex lacks is negative in the frames).
-long vertex_atom(const std::map<std::string, std::vector<double>>& p, size_t v, const std::string& side) {
-  const auto found = p.find(side + "_atom");
-  return found == p.end() || found->second[v] < 0 ? -1 : static_cast<long>(found->second[v]);
-}
 
 // Each frame's colours: by patch type, by the age of its ids (frames lived,
-// as the viewer's), uniform, or by the chain or element of its atom.
+// as the viewer's), uniform, or by the chain or element of its atom (the
+// colours of render's PNGs).
 void colour_frames(std::vector<MovieFrame>& frames, std::vector<std::map<std::string, std::vector<double>>>& props,
                    const MovieOptions& o, const ViewInput& input) {
   static const Colour by_patch[] = {{0.45f, 0.65f, 0.90f}, {0.98f, 0.80f, 0.40f}, {0.95f, 0.55f, 0.35f}, {0.85f, 0.35f, 0.40f}};
@@ -126,7 +114,7 @@ void colour_frames(std::vector<MovieFrame>& frames, std::vector<std::map<std::st
           const long a = vertex_atom(p, v, side);
           if (a < 0 || !column.count(side) || static_cast<size_t>(a) >= column[side].size()) continue;
           const std::string& key = column[side][static_cast<size_t>(a)];
-          c = hue(ordinal.emplace(key, ordinal.size()).first->second);
+          c = o.colour == "element" ? element_colour(key) : palette(ordinal.emplace(key, ordinal.size()).first->second);
           break;
         }
       }

@@ -62,6 +62,16 @@ std::vector<ViewFrame> morph_frames(const fs::path& dir) {
 
 }  // namespace
 
+long vertex_atom(const std::map<std::string, std::vector<double>>& p, size_t v, const std::string& side) {
+  auto column = p.find(side == "mesh" ? "atom" : side + "_atom");
+  if (side == "mesh" && column == p.end()) column = p.find("atomid");
+  if (column == p.end() || v >= column->second.size()) return -1;
+  const double value = column->second[v];
+  const auto flag = p.find("has_" + side + "_atom");
+  if (value < 0 || value >= 4294967295.0 || (flag != p.end() && flag->second[v] == 0)) return -1;
+  return static_cast<long>(value);
+}
+
 ViewInput find_view_input(const std::string& path) {
   ViewInput input;
   input.morph = fs::is_directory(path);

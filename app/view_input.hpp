@@ -33,4 +33,10 @@ ViewInput find_view_input(const std::string& path);
 // its file name: {"mesh", "OUT.atoms.tsv"} or {"source", ...}, {"target", ...}.
 std::vector<std::pair<std::string, std::string>> atom_table_names(const std::string& path, bool morph);
 
+// A vertex's atom on one side ("mesh", "source" or "target") from a PLY's
+// vertex properties, or -1 where it has none: read by name (a mesh's atom or
+// atomid; a frame's source_atom, target_atom), a negative value or an
+// unsigned -1 meaning none, as does a has_source_atom or has_target_atom of 0.
+long vertex_atom(const std::map<std::string, std::vector<double>>& properties, size_t vertex, const std::string& side);
+
 }  // namespace skinmesh::app

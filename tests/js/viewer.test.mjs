@@ -111,7 +111,8 @@ function sameResidues(frameFile) {
   const residue = (side) => fs.readFileSync(path.join(fixtures, 'morph', `${side}_atoms.tsv`), 'utf8').trim().split('\n').slice(1)
     .map((l) => l.split('\t').slice(1, 5).join(':'));
   const source = residue('source'), target = residue('target');
-  return ply.properties.source_atom.every((a, i) => a >= 0 && ply.properties.target_atom[i] >= 0 &&
+  const has = (side, i) => ply.properties[`${side}_atom`][i] >= 0 && (ply.properties[`has_${side}_atom`]?.[i] ?? 1) !== 0;
+  return ply.properties.source_atom.every((a, i) => has('source', i) && has('target', i) &&
                                                    source[a] === target[ply.properties.target_atom[i]]);
 }
 
