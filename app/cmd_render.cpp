@@ -43,11 +43,17 @@ void add_render_options(CLI::App& cmd, RenderCommandOptions& o) {
       ->required();
   add_molecule_settings(cmd, o.molecule);
   cmd.add_option("--output,-o", o.output, "PNG file (a molecule or a mesh file)");
-  cmd.add_option("--movie", o.movie.path,
-                 "a morph directory's movie: .mp4 (H.264) or .webm (VP9), made by ffmpeg; ids interpolated between "
-                 "frames");
-  cmd.add_option("--seconds", o.movie.seconds, "the movie's length")->check(finite_number())->check(CLI::Range(0.04, 3600.0));
-  cmd.add_option("--fps", o.movie.fps, "the movie's pictures a second")->check(finite_number())->check(CLI::Range(1.0, 120.0));
+  CLI::Option* movie = cmd.add_option("--movie", o.movie.path,
+                                      "a morph directory's movie: .mp4 (H.264) or .webm (VP9), made by ffmpeg; ids "
+                                      "interpolated between frames");
+  cmd.add_option("--seconds", o.movie.seconds, "the movie's length")
+      ->check(finite_number())
+      ->check(CLI::Range(0.04, 3600.0))
+      ->needs(movie);
+  cmd.add_option("--fps", o.movie.fps, "the movie's pictures a second")
+      ->check(finite_number())
+      ->check(CLI::Range(1.0, 120.0))
+      ->needs(movie);
   cmd.add_option("--colour,--color", o.colour,
                  "a molecule's vertices by patch (sphere, saddle, concave), element, chain, or uniform; a mesh file "
                  "is uniform; a movie by patch, age (frames its id has lived), uniform, or chain or element (from "

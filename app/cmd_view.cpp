@@ -174,11 +174,25 @@ struct Page {
   size_t embedded_bytes = 0;  // compressed
 };
 
+// The name the page knows a file by: embedded, a short one of its own; else
+// its address relative to the page, which must lie in the page's folder or
+// below it (a server of that folder serves nothing above it).
 std::string page_name(const std::string& path, const ViewOptions& o, size_t k) {
   if (!o.no_embed) return (k == SIZE_MAX ? fs::path(path).filename().string() : "frame_" + std::to_string(k) + ".ply");
   const fs::path folder = fs::absolute(o.output).parent_path();
-  return fs::relative(fs::absolute(path), folder).generic_string();
+  const std::string name = fs::relative(fs::absolute(path), folder).generic_string();
+  if (name.empty() || name.rfind("..", 0) == 0)
+    unusable_output(o.output, "a --no-embed page reads its files from its own folder or below, and " + path +
+                                  " is not there: write the page into the folder that holds them (e.g. " +
+                                  (fs::path(path).parent_path() / "index.html").string() + ")");
+  return name;
 }
+
+// Refused when the page would hold more than --max-embedded-mb, as soon as
+// the files compressed so far pass it.
+struct TooLarge {
+  size_t bytes;
+};
 
 Page make_page(const ViewInput& input, const ViewOptions& o) {
   Page page;
@@ -190,6 +204,7 @@ Page make_page(const ViewInput& input, const ViewOptions& o) {
   auto add = [&](const std::string& name, const std::function<std::string()>& bytes) {
     PageFile f{name, o.no_embed ? std::string() : gzip(bytes())};
     page.embedded_bytes += f.compressed.size();
+    if (static_cast<double>(page.embedded_bytes) > o.max_embedded_mb * 1048576) throw TooLarge{page.embedded_bytes};
     page.files.push_back(std::move(f));
   };
   json frames = json::array();
@@ -244,13 +259,15 @@ std::string page_html(const Page& page) {
 ExitCode run_view(const ViewOptions& o, const GlobalOptions& global) {
   check_writable({o.output});
   const ViewInput input = find_view_input(o.input);
-  const Page page = make_page(input, o);
-  const double limit = o.max_embedded_mb * 1024 * 1024;
-  if (static_cast<double>(page.embedded_bytes) > limit) {
-    std::cerr << "skinmesh: error: " << o.input << ": " << page.embedded_bytes / 1048576.0
+  Page page;
+  try {
+    page = make_page(input, o);
+  } catch (const TooLarge& large) {
+    const fs::path folder = input.morph ? fs::path(o.input) : fs::path(o.input).parent_path();
+    std::cerr << "skinmesh: error: " << o.input << ": at least " << large.bytes / 1048576.0
               << " MiB compressed, more than a page may embed (--max-embedded-mb " << o.max_embedded_mb
               << "); nothing written. Write a page that reads the files beside it instead: skinmesh view " << o.input
-              << " -o " << (input.morph ? (fs::path(o.input) / "index.html").string() : "page.html")
+              << " -o " << (folder / "index.html").string()
               << " --no-embed, then serve that folder (python3 -m http.server) and open the page from there "
                  "(docs/viewing.md)\n";
     return ExitCode::bad_input;

@@ -530,7 +530,7 @@
       if (key === 'colour') state.colour = v;
       else if (Number.isFinite(Number(v))) state[key] = Number(v);
     }
-    state.t = Math.max(0, Math.min(1, state.t));
+    state.t = Math.max(tRange()[0], Math.min(tRange()[1], state.t));
     state.zoom = Math.max(0.05, Math.min(50, state.zoom));
     state.pitch = Math.max(-90, Math.min(90, state.pitch));
     if (!modes[state.colour] || !modeAvailable(state.colour)) {
@@ -539,6 +539,9 @@
     }
     playing = state.play === 1 && scene.kind === 'morph';
   }
+
+  // The frames' t: 0 to 1 for a morph, 0 to the last model's index for a trajectory.
+  const tRange = () => [scene.frames[0].t, scene.frames[scene.frames.length - 1].t];
 
   function firstMode() {
     const preferred = scene.kind === 'morph' ? ['source-residue', 'patch'] : ['residue', 'patch'];
@@ -550,9 +553,8 @@
     clearTimeout(fragmentTimer);
     fragmentTimer = setTimeout(() => {
       const round = (v) => String(Math.round(v * 1000) / 1000);
-      const parts = [`t=${round(state.t)}`, `colour=${state.colour}`, `yaw=${round(state.yaw)}`, `pitch=${round(state.pitch)}`,
-                     `zoom=${round(state.zoom)}`];
-      if (scene.kind === 'morph') parts.push(`speed=${round(state.speed)}`, `play=${playing ? 1 : 0}`);
+      const parts = [`colour=${state.colour}`, `yaw=${round(state.yaw)}`, `pitch=${round(state.pitch)}`, `zoom=${round(state.zoom)}`];
+      if (scene.kind === 'morph') parts.unshift(`t=${round(state.t)}`), parts.push(`speed=${round(state.speed)}`, `play=${playing ? 1 : 0}`);
       history.replaceState(null, '', `#${parts.join('&')}`);
     }, 150);
   }
@@ -607,10 +609,9 @@
 
   function frameLoop(now) {
     if (playing) {
-      const fr = scene.frames, span = fr[fr.length - 1].t - fr[0].t || 1;
-      const dt = lastTick ? (now - lastTick) / 1000 : 0;
-      state.t += dt * state.speed * span / Math.max(1, fr.length - 1);
-      if (state.t > 1) state.t = 0;
+      const [t0, t1] = tRange(), dt = lastTick ? (now - lastTick) / 1000 : 0;
+      state.t += dt * state.speed * (t1 - t0 || 1) / Math.max(1, scene.frames.length - 1);
+      if (state.t > t1) state.t = t0;
       dirty = true;
       writeFragment();
     }
@@ -756,6 +757,8 @@
     if (scene.colourNote) notes.push(scene.colourNote);
     $('note').textContent = notes.join(' ');
     if (scene.kind === 'morph') $('morph-controls').classList.remove('hidden');
+    const [t0, t1] = tRange();
+    Object.assign($('t'), { min: t0, max: t1, step: (t1 - t0) / 1000 || 0.001 });
     select.addEventListener('change', () => { state.colour = select.value; legend(); dirty = true; writeFragment(); });
     $('t').addEventListener('input', (e) => { state.t = Number(e.target.value); playing = false; dirty = true; writeFragment(); });
     $('play').addEventListener('click', () => { playing = !playing; lastTick = 0; dirty = true; writeFragment(); });

@@ -124,12 +124,18 @@ TEST_CASE("view writes one page holding the viewer and the mesh, or one that rea
   CHECK(html.find("http://") == std::string::npos);
   CHECK(html.find("https://") == std::string::npos);
   CHECK(report["page_bytes"].get<size_t>() == html.size());
-  // --no-embed: the page names the files by their addresses and holds none.
-  fs::create_directory(dir / "site");
-  REQUIRE(run("--quiet view " + dir / "pept.ply" + " -o " + dir / "site/index.html --no-embed").code == 0);
-  const std::string served = read_text(dir / "site/index.html");
+  // --no-embed: the page names the files by their addresses and holds none;
+  // they must be in its folder or below, where a server of that folder finds them.
+  REQUIRE(run("--quiet view " + dir / "pept.ply" + " -o " + dir / "index.html --no-embed").code == 0);
+  const std::string served = read_text(dir / "index.html");
   CHECK(served.find("data-file=") == std::string::npos);
-  CHECK(served.find("\"../pept.ply\"") != std::string::npos);
+  CHECK(served.find("\"file\":\"pept.ply\"") != std::string::npos);
+  CHECK(served.find("\"pept.atoms.tsv\"") != std::string::npos);
+  fs::create_directory(dir / "site");
+  const Run above = run("view " + dir / "pept.ply" + " -o " + dir / "site/index.html --no-embed");
+  CHECK(above.code == 2);
+  CHECK(above.output.find(dir / "index.html") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "site/index.html"));
 }
 
 TEST_CASE("view refuses a page too large to embed, a directory that is no morph and a bad atom table", "[cli][view][bad]") {
@@ -210,6 +216,8 @@ TEST_CASE("render --movie of a morph: ffprobe finds every picture at the size as
   }
   CHECK(run("render " + skinmesh::test::data_file("pept.pdb") + " --movie " + dir / "x.mp4").code == 2);
   CHECK(run("render " + dir / "m -o " + dir / "x.png").code == 2);
+  CHECK(run("render " + skinmesh::test::data_file("pept.pdb") + " -o " + dir / "x.png --fps 10").code == 2);
+  CHECK(run("render " + skinmesh::test::data_file("pept.pdb") + " -o " + dir / "x.png --colour age").code == 2);
   const Run no_ffmpeg = shell("PATH=/nonexistent " + std::string(SKINMESH_BINARY) + " render " + dir / "m --movie " + dir / "x.mp4");
   CHECK(no_ffmpeg.code != 0);
   CHECK(no_ffmpeg.output.find("ffmpeg") != std::string::npos);

@@ -2,8 +2,9 @@
 # The viewer tests' inputs, made by the skinmesh command under test:
 #   make_fixtures.sh SKINMESH DATA_DIR OUT_DIR
 # 1ubi's mesh with its atom table; the same mesh without one; 2k39 model 1 ->
-# 3 as a morph of 5 frames with both sides' atom tables; an embedded page of
-# each, and a --no-embed page inside the morph's directory. The atom tables
+# 3 as a morph of 5 frames with both sides' atom tables; its three models as
+# a trajectory (t from 0 to 2); an embedded page of each, and a --no-embed
+# page inside the morph's directory. The atom tables
 # are those the commands write beside their outputs, or where a build writes
 # none, tests/js/atom_table.py's (the rows skinmesh keeps by default, in
 # file order); their row counts are checked against what skinmesh used.
@@ -27,7 +28,9 @@ for side in source target; do
   balls=$(grep -vc "^#" "$out/morph/$side.xyzr")
   [ "$rows" = "$balls" ] || { echo "2k39 $side: $rows rows, $balls atoms in the morph" >&2; exit 1; }
 done
+"$skinmesh" --quiet trajectory "$data/2k39_3models.pdb" --frames-per-step 2 --format ply -o "$out/traj"
 "$skinmesh" --quiet view "$out/1ubi.ply" -o "$out/1ubi.html"
+"$skinmesh" --quiet view "$out/traj" -o "$out/traj.html"
 "$skinmesh" --quiet view "$out/plain/1ubi.ply" -o "$out/plain/1ubi.html"
 "$skinmesh" --quiet view "$out/morph" -o "$out/morph.html"
 "$skinmesh" --quiet view "$out/morph" -o "$out/morph/index.html" --no-embed

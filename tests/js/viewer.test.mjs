@@ -137,6 +137,15 @@ const cases = {
     const end = await pixels(page);
     const n = differing(start, end);
     assert.ok(n > 0.01 * WIDTH * HEIGHT, `t = 0 and t = 1 differ in ${n} pixels only`);
+    // A trajectory's t runs from 0 to its last model's index.
+    const traj = (await openOffline(context, 'traj.html', 't=1.5&colour=patch')).page;
+    assert.deepEqual((await traj.evaluate(() => window.skinmeshViewer.frames())).map((f) => f.t), [0, 0.5, 1, 1.5, 2]);
+    assert.equal((await traj.evaluate(() => window.skinmeshViewer.state())).t, 1.5);
+    const between = await traj.evaluate(() => window.skinmeshViewer.positionsAt(1.25));
+    assert.deepEqual([between.from.file, between.to.file, between.s], ['frame_2.ply', 'frame_3.ply', 0.5]);
+    const middle = await pixels(traj);
+    await setFragment(traj, 't=2&colour=patch');
+    assert.ok(differing(middle, await pixels(traj)) > 0.01 * WIDTH * HEIGHT, 'the trajectory does not move from t = 1.5 to 2');
   },
 
   // Between two frames, every vertex whose id both hold is at its place
@@ -184,7 +193,7 @@ const cases = {
       for (const m of expected) assert.ok(modes.includes(m), `${file} lacks colour ${m} (has ${modes})`);
       const pictures = [];
       for (const m of modes) {
-        await setFragment(page, `t=0.5&colour=${m}`);
+        await setFragment(page, file === 'morph.html' ? `t=0.5&colour=${m}` : `colour=${m}`);
         pictures.push([m, await pixels(page)]);
         if (file === '1ubi.html') await shot(page, `1ubi-${m}.png`);
       }
