@@ -684,7 +684,7 @@
     for (const side of Object.keys(f.atoms)) {
       const index = f.atoms[side][vertex];
       const a = scene.tables[side] && index >= 0 ? scene.tables[side].atoms[index] : null;
-      out.atoms[side] = { index, ...(a ? { chain: a.chain, residue_number: a.residue_number, insertion_code: a.insertion_code,
+      out.atoms[side] = { index, table: !!scene.tables[side], ...(a ? { chain: a.chain, residue_number: a.residue_number, insertion_code: a.insertion_code,
                                            residue_name: a.residue_name, atom_name: a.atom_name, element: a.element } : {}) };
     }
     return out;
@@ -706,7 +706,7 @@
     const line = (side, a) => {
       const name = side === 'mesh' ? 'atom' : `${side} atom`;
       if (a.index < 0) return `${name}: none`;
-      if (!a.atom_name) return `${name} ${a.index} (no atom table)`;
+      if (!a.atom_name) return `${name} ${a.index} (${a.table ? 'not in the atom table' : 'no atom table'})`;
       return `${name} ${a.index}: ${a.atom_name} of ${a.residue_name} ${a.residue_number}${a.insertion_code}, chain ${a.chain || '-'}`;
     };
     return [`vertex ${p.vertex} of ${p.file}`, ...Object.entries(p.atoms).map(([s, a]) => line(s, a))].join('\n');
