@@ -7,10 +7,12 @@
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
+#include "vertex_colours.hpp"
 
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/mesh_io/atom_table.hpp"
 #include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/quality/guarantees.hpp"
@@ -18,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 namespace skinmesh::app {
@@ -31,24 +34,45 @@ struct MeshCommandOptions {
   MeshingOptions meshing;
   double max_memory_gb = 0;  // 0: the memory available when the command starts
   bool single_precision = false;
+  bool ascii = false;              // PLY as text (PyMOL 2.5 reads no binary PLY)
+  std::string colour = "patch";    // per-vertex colours of PLY and glTF (vertex_colours.hpp)
   bool no_self_intersections = false;
   bool outer_only = false;  // drop the components another encloses (cavities, islands in them)
 };
 
-// The patch type and the atom that owns each vertex.
-VertexAttributes attributes_of(const SkinComplex& complex, const SurfaceMesh& mesh) {
+// The patch type and the atom that owns each vertex (atom, and atomid,
+// unsigned, which Mol* groups a PLY by), and the colours asked for.
+VertexAttributes attributes_of(const SkinComplex& complex, const SurfaceMesh& mesh, const Molecule& m,
+                               Colouring colouring) {
   VertexAttributes a;
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     a.patch.push_back(complex.cell(mesh.cells[v]).dim);
     a.atom.push_back(complex.owning_ball(mesh.vertices[v], mesh.cells[v]));
   }
+  a.more = {{"atomid", PropertyType::uint32, a.atom}};
+  std::vector<Rgb> by_atom;
+  if (colours_by_atom(colouring)) {
+    const std::vector<Rgb> table = atom_colours(colouring, m.atoms);
+    for (int atom : a.atom) by_atom.push_back(table[static_cast<size_t>(atom)]);
+  }
+  a.colours = vertex_colours(colouring, mesh, a.patch, by_atom);
   return a;
+}
+
+// OUT.ply -> OUT.atoms.tsv (the table the per-vertex atom indices name).
+std::string atom_table_path(const std::string& mesh_path) {
+  return std::filesystem::path(mesh_path).replace_extension(".atoms.tsv").string();
 }
 
 void add_mesh_options(CLI::App& cmd, MeshCommandOptions& o) {
   add_molecule_options(cmd, o.molecule);
-  cmd.add_option("--output,-o", o.output, "mesh file: .ply .off .obj .stl .vtp .msh (Gmsh), or .vert (MSMS .vert + .face)")
+  cmd.add_option("--output,-o", o.output,
+                 "mesh file: .ply .off .obj .stl .vtp .msh (Gmsh), .glb (glTF), or .vert (MSMS .vert + .face); "
+                 "the table of its atoms goes beside it (OUT.atoms.tsv)")
       ->required();
+  cmd.add_option("--colour,--color", o.colour, colouring_help())
+      ->check(CLI::IsMember(colouring_names()))->capture_default_str();
+  cmd.add_flag("--ascii", o.ascii, "write a PLY as text (PyMOL 2.5 opens text PLY only)");
   cmd.add_flag("--outer-only", o.outer_only,
                "keep only the outer surface: drop every component another encloses (cavities, and anything inside "
                "them), as a boundary-element solver of the exterior wants");
@@ -99,17 +123,19 @@ std::vector<std::string> output_paths(const MeshCommandOptions& o, MeshFormat fo
   } else {
     paths = {o.output};
   }
+  paths.push_back(atom_table_path(o.output));
   if (!o.svg.empty()) paths.push_back(o.svg);
   if (!o.report.empty()) paths.push_back(o.report);
   return paths;
 }
 
 // The mesh, its attributes, the report and the histogram, all or none.
-void write_outputs(const MeshCommandOptions& o, MeshFormat format, const SkinComplex& complex,
+void write_outputs(const MeshCommandOptions& o, MeshFormat format, const SkinComplex& complex, const Molecule& m,
                    const SurfaceMesh& mesh, const MeshQuality& q, json& report, Clock::time_point start) {
-  const VertexAttributes attributes = attributes_of(complex, mesh);
+  const VertexAttributes attributes = attributes_of(complex, mesh, m, colouring_from_name(o.colour));
   MeshWriteOptions write;
   write.single_precision = o.single_precision;
+  write.ascii = o.ascii;
   OutputSet outputs;
   if (format == MeshFormat::msms) {
     const std::string stem = o.output.substr(0, o.output.size() - 5);
@@ -118,6 +144,7 @@ void write_outputs(const MeshCommandOptions& o, MeshFormat format, const SkinCom
   } else {
     outputs.add(o.output, [&](std::ostream& out) { write_mesh(out, mesh, format, &attributes, write); });
   }
+  outputs.add(atom_table_path(o.output), [&](std::ostream& out) { write_atom_table(out, m); });
   if (!o.svg.empty()) outputs.add(o.svg, [&](std::ostream& out) { write_svg(out, q, o.output); });
   report["seconds"]["total"] = seconds_since(start);
   if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << json_text(report) << "\n"; });
@@ -143,6 +170,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   const MeshFormat format = mesh_format_from_path(o.output);
+  if (o.ascii && format != MeshFormat::ply) contract_error("--ascii: only a PLY has a text form to choose (" + o.output + ")");
   check_writable(output_paths(o, format));
   const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
   if (progress)
@@ -186,6 +214,8 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
                  {"weights", convention_name(o.molecule.convention())},
                  {"output", o.output},
                  {"format", mesh_format_name(format)},
+                 {"atom_table", atom_table_path(o.output)},
+                 {"colour", o.colour},
                  {"options", options_json(meshing)},
                  {"quality", to_json(g.quality)},
                  {"outer_only", o.outer_only},
@@ -212,7 +242,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
               << "\n";
     return ExitCode::not_met;
   }
-  write_outputs(o, format, complex, mesh, g.quality, report, start);
+  write_outputs(o, format, complex, m, mesh, g.quality, report, start);
   if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet) print_summary(o, g, report);
   return ExitCode::ok;

@@ -4,6 +4,7 @@
 // is written, into a self-describing directory (docs/morph.md).
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "frame_options.hpp"
 #include "meshing_feedback.hpp"
 #include "morph_frames.hpp"
 #include "molecule_options.hpp"
@@ -54,7 +55,7 @@ struct MorphCommandOptions {
   std::string pairs = "auto";
   std::string spacing = "uniform";
   double max_step = MovingOptions{}.max_step;  // Angstrom, --pairs matched
-  std::vector<std::string> formats{"ply", "vtp"};
+  FrameFileOptions files;
   MorphOptions morph;
   bool no_self_intersections = false;
 };
@@ -98,9 +99,7 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
       ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--threads", o.morph.first.threads, "threads (0: all)")
       ->check(finite_number())->check(non_negative_number());
-  cmd.add_option("--format", o.formats, "mesh formats per frame, comma-separated: ply vtp off obj stl "
-                                        "(frames.pvd needs vtp)")
-      ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl"}))->capture_default_str();
+  add_frame_file_options(cmd, o.files);
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
   add_molecule_settings(cmd, o.molecule, ModelChoice::none);
 }
@@ -227,26 +226,18 @@ json blend_frame_json(const FrameStats& s, const FrameCheck& c, const std::strin
   return j;
 }
 
-// The frame's mesh in every format asked for, with per-vertex patch, id and
-// the source and target atoms (the column "atom" repeats the source atom).
-void stage_frame(OutputSet& outputs, const OutputDirectory& dir, size_t k, const Morph& morph,
-                 const std::vector<std::string>& formats) {
+// The frame as `files` says, with per-vertex patch, id and the source and
+// target atoms ("atom" and atomid: the source atom where there is one, the
+// target atom otherwise).
+void stage_frame(OutputSet& outputs, const OutputDirectory& dir, size_t k, const Morph& morph, FrameFiles& files) {
   const MorphFrame& f = morph.frame();
-  VertexAttributes a;
-  std::vector<int> ids, source_atoms, target_atoms;
-  const std::vector<std::array<int, 2>> atoms = morph.vertex_atoms();
-  for (size_t v = 0; v < f.mesh.vertices.size(); ++v) {
-    a.patch.push_back(morph.complex().cell(f.mesh.cells[v]).dim);
-    a.atom.push_back(atoms[v][0]);
-    ids.push_back(static_cast<int>(f.ids[v]));
-    source_atoms.push_back(atoms[v][0]);
-    target_atoms.push_back(atoms[v][1]);
-  }
-  a.more = {{"id", ids}, {"source_atom", source_atoms}, {"target_atom", target_atoms}};
-  for (const std::string& format : formats) {
-    const MeshFormat mf = mesh_format_from_path(frame_name(k, format));
-    outputs.add(dir.file(frame_name(k, format)), [&](std::ostream& out) { write_mesh(out, f.mesh, mf, &a); });
-  }
+  std::vector<int> patch;
+  for (int cell : f.mesh.cells) patch.push_back(morph.complex().cell(cell).dim);
+  const std::vector<std::array<int, 2>> sides = morph.vertex_atoms();
+  std::vector<int> atom;
+  for (const auto& [s, t] : sides) atom.push_back(s >= 0 ? s : t);
+  VertexAttributes a = frame_attributes(std::move(patch), std::move(atom), f.ids, sides);
+  stage_frame_files(outputs, dir, k, f.mesh, a, sides, files);
 }
 
 json alignment_json(const Alignment& a, long unmoved) {
@@ -287,6 +278,18 @@ json sides_json(const MorphCommandOptions& o, const Sides& sides) {
           {"target_atoms", sides.target_balls.size()},
           {"shrink", o.molecule.shrink},
           {"weights", convention_name(o.molecule.convention())}};
+}
+
+// frames.pvd (with vtp), frames.glb (with glb), the atom tables; named in the report.
+void stage_common_files(OutputSet& outputs, const OutputDirectory& dir, FrameFiles& files, const Sides& sides,
+                        const std::vector<double>& times, json& report) {
+  const bool pvd = files.wants("vtp");
+  if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, times); });
+  report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
+  report["glb"] = files.wants("glb") ? json("frames.glb") : json(nullptr);
+  report["colour"] = files.options.colour;
+  report["atom_tables"] = {"source_atoms.tsv", "target_atoms.tsv"};
+  stage_frame_set_files(outputs, dir, files, sides.source, sides.target);
 }
 
 json morph_json(const MorphCommandOptions& o, const Sides& sides, const Morph& morph, const std::vector<double>& t,
@@ -357,13 +360,13 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
   for (const MatchedMotion::Track& track : motion.tracks) run.ball_atoms.push_back({track.source, track.target});
   run.options = moving_options(options);
   run.options.max_step = o.max_step;
-  run.formats = o.formats;
+  FrameFiles files(o.files, sides.source, sides.target);
   run.self_intersections = !o.no_self_intersections;
   if (progress) run.progress = std::make_shared<ProgressLine>(true);
   OutputDirectory dir(o.directory);
   OutputSet outputs;
   std::ostringstream lines;
-  const MovingFramesResult result = run_moving_frames(run, outputs, dir, lines);
+  const MovingFramesResult result = run_moving_frames(run, files, outputs, dir, lines);
   if (!result.holds) {
     if (run.progress) run.progress->finish();
     std::cerr << "skinmesh: error: frame " << result.failed_index << " (t = " << times[result.failed_index]
@@ -392,9 +395,7 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
                  {"max_step", run.options.max_step}});
   report["source_balls_file"] = stage_side(outputs, dir, "source", sides.source, sides.source_balls);
   report["target_balls_file"] = stage_side(outputs, dir, "target", sides.target, sides.target_balls);
-  const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
-  if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, times); });
-  report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
+  stage_common_files(outputs, dir, files, sides, times, report);
   result.counts.into(report);
   report["min_ids_kept"] = result.min_ids_kept;
   report["max_kept_move"] = result.max_kept_move;
@@ -444,7 +445,7 @@ std::vector<double> change_spaced(size_t frames, const std::function<std::vector
 }
 
 ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& global) {
-  check_formats(o.formats);
+  check_formats(o.files.formats);
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   std::vector<double> times = frame_times(o);
@@ -470,6 +471,7 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
     std::cerr << "skinmesh: pairs " << (pairing.matched ? "matched" : "all") << ": " << pairing.why << "\n";
   }
   if (pairing.matched) return run_matched_morph(o, global, sides, times, pairing, start);
+  FrameFiles files(o.files, sides.source, sides.target);
   OutputDirectory dir(o.directory);
   OutputSet outputs;
   const auto shown = std::make_shared<ProgressLine>(progress);
@@ -487,14 +489,14 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
     const MorphFrame& f =
         k == 0 ? morph.frame() : morph.advance_to(times[k], k + 1 < times.size() ? times[k + 1] : -1);
     const FrameCheck check = check_frame(f.mesh, reference, times[k], options.frames.min_angle, !o.no_self_intersections);
-    json line = blend_frame_json(f.stats, check, frame_name(k, o.formats.front()));
+    json line = blend_frame_json(f.stats, check, files.listed_file(k));
     if (!check.holds) {
       shown->finish();
       std::cerr << "skinmesh: error: frame " << k << " (t = " << times[k] << ") fails a guarantee; nothing written\n"
                 << json_text(line) << "\n";
       return ExitCode::not_met;
     }
-    stage_frame(outputs, dir, k, morph, o.formats);
+    stage_frame(outputs, dir, k, morph, files);
     lines << json_text(line, JsonLayout::one_line) << "\n";
     counts.add(line);
     pace.done_one();
@@ -509,9 +511,7 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
   report["pairs_because"] = pairing.why;
   report["source_balls_file"] = stage_side(outputs, dir, "source", sides.source, sides.source_balls);
   report["target_balls_file"] = stage_side(outputs, dir, "target", sides.target, sides.target_balls);
-  const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
-  if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, times); });
-  report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
+  stage_common_files(outputs, dir, files, sides, times, report);
   counts.into(report);
   report["seconds"] = seconds_since(start);
   outputs.add(dir.file("frames.jsonl"), [&](std::ostream& out) { out << lines.str(); });

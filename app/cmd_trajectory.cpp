@@ -5,6 +5,7 @@
 // ids (morph/moving_balls.hpp; docs/morph.md, "Trajectories").
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "frame_options.hpp"
 #include "molecule_options.hpp"
 #include "meshing_feedback.hpp"
 #include "morph_frames.hpp"
@@ -36,7 +37,7 @@ struct TrajectoryOptions {
   int frames_per_step = 5;   // frames from one keyframe to the next (the next keyframe included)
   std::string align = "kabsch";
   MovingOptions moving;
-  std::vector<std::string> formats{"ply", "vtp"};
+  FrameFileOptions files;
   bool no_self_intersections = false;
 };
 
@@ -62,8 +63,7 @@ void add_trajectory_options(CLI::App& cmd, TrajectoryOptions& o) {
       ->check(finite_number())->check(positive_number())->capture_default_str();
   cmd.add_option("--max-triangles", o.moving.first.max_triangles, "stop with an error past this many triangles")
       ->check(finite_number())->check(positive_number())->capture_default_str();
-  cmd.add_option("--format", o.formats, "mesh formats per frame, comma-separated: ply vtp off obj stl")
-      ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl"}))->capture_default_str();
+  add_frame_file_options(cmd, o.files);
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
   add_molecule_settings(cmd, o.molecule, ModelChoice::none);
 }
@@ -126,7 +126,7 @@ std::vector<std::vector<Ball>> keyframe_balls(const TrajectoryOptions& o, const 
 }
 
 ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& global) {
-  check_formats(o.formats);
+  check_formats(o.files.formats);
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   const std::vector<Molecule> all = read_all_models(o.molecule.path, o.molecule.read);
@@ -152,7 +152,10 @@ ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& 
   run.options.frames = run.options.first;
   run.options.frames.min_angle = angle;
   run.options.first.min_angle = std::max(30.0, angle);
-  run.formats = o.formats;
+  // Every model holds the first one's atoms, and the balls are in its
+  // order: both sides' atoms are the first model's (one table, twice).
+  const Molecule& first = all[static_cast<size_t>(models.front() - 1)];
+  FrameFiles files(o.files, first, first);
   run.self_intersections = !o.no_self_intersections;
   if (progress) run.progress = std::make_shared<ProgressLine>(true);
   if (progress)
@@ -161,7 +164,7 @@ ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& 
   OutputDirectory dir(o.directory);
   OutputSet outputs;
   std::ostringstream lines;
-  const MovingFramesResult result = run_moving_frames(run, outputs, dir, lines);
+  const MovingFramesResult result = run_moving_frames(run, files, outputs, dir, lines);
   if (!result.holds) {
     if (run.progress) run.progress->finish();
     std::cerr << "skinmesh: error: frame " << result.failed_index << " fails a guarantee; nothing written\n"
@@ -192,9 +195,13 @@ ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& 
                  {"max_kept_move", result.max_kept_move},
                  {"seconds", seconds_since(start)}};
   result.counts.into(report);
-  const bool pvd = std::find(o.formats.begin(), o.formats.end(), "vtp") != o.formats.end();
+  const bool pvd = files.wants("vtp");
   if (pvd) outputs.add(dir.file("frames.pvd"), [&](std::ostream& out) { write_pvd(out, run.times); });
   report["pvd"] = pvd ? json("frames.pvd") : json(nullptr);
+  report["glb"] = files.wants("glb") ? json("frames.glb") : json(nullptr);
+  report["colour"] = files.options.colour;
+  report["atom_tables"] = {"source_atoms.tsv", "target_atoms.tsv"};
+  stage_frame_set_files(outputs, dir, files, first, first);
   outputs.add(dir.file("frames.jsonl"), [&](std::ostream& out) { out << lines.str(); });
   outputs.add(dir.file("trajectory.json"), [&](std::ostream& out) { out << json_text(report) << "\n"; });
   outputs.commit();

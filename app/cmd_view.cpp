@@ -55,8 +55,9 @@ void add_view_options(CLI::App& cmd, ViewOptions& o) {
       ->check(positive_number());
 }
 
-// A PLY of what the page needs, small: float positions, no normals (the
-// page computes them), every other vertex property as int, uint or float.
+// A PLY of what the page needs, small: float positions, no normals or
+// colours (the page makes its own), every other vertex property as int,
+// uint or float.
 std::string compact_ply(const std::string& path) {
   PlyMesh ply;
   if (fs::path(path).extension() == ".ply") ply = read_ply_with_properties(path);
@@ -65,7 +66,9 @@ std::string compact_ply(const std::string& path) {
   if (m.triangles.empty()) input_error(path, 0, "no triangles to show");
   std::vector<std::pair<std::string, const char*>> columns;  // name, PLY type
   for (const auto& [name, values] : ply.vertex_properties) {
-    if (name == "nx" || name == "ny" || name == "nz") continue;
+    // Normals are computed in the page, colours chosen there.
+    if (name == "nx" || name == "ny" || name == "nz" || name == "red" || name == "green" || name == "blue" || name == "alpha")
+      continue;
     double lo = 0, hi = 0;
     bool whole = true;
     for (double v : values) {

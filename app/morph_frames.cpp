@@ -10,6 +10,8 @@
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/mesh_io/atom_table.hpp"
+#include "skinmesh/mesh_io/glb_write.hpp"
 #include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
@@ -90,6 +92,78 @@ std::string frame_name(size_t k, const std::string& format) {
   char name[64];
   std::snprintf(name, sizeof name, "frame_%04zu.%s", k, format.c_str());
   return name;
+}
+
+FrameFiles::FrameFiles(const FrameFileOptions& o, const Molecule& source, const Molecule& target)
+    : options(o), colouring(colouring_from_name(o.colour)) {
+  check_formats(o.formats);
+  if (o.ascii && !wants("ply")) contract_error("--ascii: only PLY frames have a text form to choose; add ply to --format");
+  source_colours = atom_colours(colouring, source.atoms);
+  target_colours = atom_colours(colouring, target.atoms);
+}
+
+bool FrameFiles::wants(const std::string& format) const {
+  return std::find(options.formats.begin(), options.formats.end(), format) != options.formats.end();
+}
+
+std::string FrameFiles::listed_file(size_t k) const {
+  for (const std::string& f : options.formats)
+    if (f != "glb") return frame_name(k, f);
+  return "frames.glb";
+}
+
+VertexAttributes frame_attributes(std::vector<int> patch, std::vector<int> atom, const std::vector<long>& ids,
+                                  const std::vector<std::array<int, 2>>& sides) {
+  VertexAttributes a;
+  a.patch = std::move(patch);
+  a.atom = std::move(atom);
+  std::vector<int> id, atomid, source, has_source, target, has_target;
+  for (size_t v = 0; v < sides.size(); ++v) {
+    const auto [s, t] = sides[v];
+    if (s < 0 && t < 0) contract_error("a frame vertex with neither a source nor a target atom");
+    id.push_back(static_cast<int>(ids[v]));
+    atomid.push_back(s >= 0 ? s : t);
+    source.push_back(std::max(s, 0));
+    has_source.push_back(s >= 0);
+    target.push_back(std::max(t, 0));
+    has_target.push_back(t >= 0);
+  }
+  a.more = {{"id", PropertyType::int32, id},
+            {"atomid", PropertyType::uint32, atomid},
+            {"source_atom", PropertyType::uint32, source},
+            {"has_source_atom", PropertyType::uint8, has_source},
+            {"target_atom", PropertyType::uint32, target},
+            {"has_target_atom", PropertyType::uint8, has_target}};
+  return a;
+}
+
+void stage_frame_files(OutputSet& outputs, const OutputDirectory& dir, size_t k, const SurfaceMesh& mesh,
+                       VertexAttributes& attributes, const std::vector<std::array<int, 2>>& sides, FrameFiles& files) {
+  std::vector<Rgb> by_atom;
+  if (colours_by_atom(files.colouring))
+    for (const auto& [s, t] : sides)
+      by_atom.push_back(s >= 0 ? files.source_colours[static_cast<size_t>(s)] : files.target_colours[static_cast<size_t>(t)]);
+  attributes.colours = vertex_colours(files.colouring, mesh, attributes.patch, by_atom);
+  MeshWriteOptions write;
+  write.ascii = files.options.ascii;
+  for (const std::string& format : files.options.formats) {
+    if (format == "glb") continue;
+    const MeshFormat mf = mesh_format_from_path(frame_name(k, format));
+    outputs.add(dir.file(frame_name(k, format)), [&](std::ostream& out) { write_mesh(out, mesh, mf, &attributes, write); });
+  }
+  if (files.wants("glb")) {
+    std::string node = frame_name(k, "glb");
+    node.resize(node.size() - 4);  // frame_0007
+    files.glb.push_back(glb_frame(mesh, attributes.colours, node, static_cast<double>(k) * FrameFiles::glb_seconds_per_frame));
+  }
+}
+
+void stage_frame_set_files(OutputSet& outputs, const OutputDirectory& dir, FrameFiles& files, const Molecule& source,
+                           const Molecule& target) {
+  if (files.wants("glb"))
+    outputs.add(dir.file("frames.glb"), [&](std::ostream& out) { write_glb(out, files.glb); });
+  outputs.add(dir.file("source_atoms.tsv"), [&](std::ostream& out) { write_atom_table(out, source); });
+  outputs.add(dir.file("target_atoms.tsv"), [&](std::ostream& out) { write_atom_table(out, target); });
 }
 
 void write_pvd(std::ostream& out, const std::vector<double>& times) {
@@ -228,30 +302,19 @@ json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::stri
   return j;
 }
 
-// The frame's mesh in every format asked for, with per vertex its patch
-// type, id, owning ball, and that ball's source and target atoms ("atom"
-// is the ball's index: the line of the frame's .wpts); and its balls.
-void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, const MadeFrame& made, const MovingFrames& run) {
+// The frame's mesh as `files` says, with per vertex its patch type, id,
+// owning ball ("atom": the line of the frame's .wpts) and that ball's
+// source and target atoms; and its balls.
+void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, const MadeFrame& made, const MovingFrames& run,
+                        FrameFiles& files) {
   const MorphFrame& f = made.frame;
-  VertexAttributes a;
-  std::vector<int> ids, source_atoms, target_atoms;
-  for (size_t v = 0; v < f.mesh.vertices.size(); ++v) {
-    const size_t ball = static_cast<size_t>(made.owner[v]);
-    a.patch.push_back(made.patch[v]);
-    a.atom.push_back(made.owner[v]);
-    ids.push_back(static_cast<int>(f.ids[v]));
-    source_atoms.push_back(run.ball_atoms[ball][0]);
-    target_atoms.push_back(run.ball_atoms[ball][1]);
-  }
-  a.more = {{"id", ids}, {"source_atom", source_atoms}, {"target_atom", target_atoms}};
+  std::vector<std::array<int, 2>> sides;
+  for (int ball : made.owner) sides.push_back(run.ball_atoms[static_cast<size_t>(ball)]);
+  VertexAttributes a = frame_attributes(made.patch, made.owner, f.ids, sides);
   const size_t k = made.index;
-  for (const std::string& format : run.formats) {
-    const MeshFormat mf = mesh_format_from_path(frame_name(k, format));
-    outputs.add(dir.file(frame_name(k, format)), [&](std::ostream& out) { write_mesh(out, f.mesh, mf, &a); });
-  }
+  stage_frame_files(outputs, dir, k, f.mesh, a, sides, files);
   outputs.add(dir.file(frame_name(k, "wpts")), [&](std::ostream& out) {
-    write_wpts(out, made.balls, "the balls of " + frame_name(k, run.formats.front()) + " (t = " +
-                                    exact_number_text(f.stats.t) + ")");
+    write_wpts(out, made.balls, "the balls of " + files.listed_file(k) + " (t = " + exact_number_text(f.stats.t) + ")");
   });
 }
 
@@ -260,8 +323,8 @@ void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, const Ma
 // Frame k is checked and written while frame k+1 is made: the engine's
 // repairs are mostly serial and the check (grading, the oracle at every
 // vertex, the exact self-intersection test) runs beside them.
-MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs, const OutputDirectory& dir,
-                                     std::ostream& lines) {
+MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files, OutputSet& outputs,
+                                     const OutputDirectory& dir, std::ostream& lines) {
   MovingFramesResult result;
   MovingOptions options = run.options;
   if (run.progress) {
@@ -277,13 +340,13 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs
   const auto finish = [&]() {
     checking.wait();
     const FrameStats& st = pending.frame.stats;
-    const json line = moving_frame_json(st, check, frame_name(pending.index, run.formats.front()));
+    const json line = moving_frame_json(st, check, files.listed_file(pending.index));
     if (!check.holds) {
       result.failed_frame = line;
       result.failed_index = pending.index;
       return false;
     }
-    stage_moving_frame(outputs, dir, pending, run);
+    stage_moving_frame(outputs, dir, pending, run, files);
     lines << json_text(line, JsonLayout::one_line) << "\n";
     result.counts.add(line);
     if (pending.index > 0) {

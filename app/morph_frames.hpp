@@ -6,10 +6,13 @@
 
 #include "output_file.hpp"
 #include "progress.hpp"
+#include "vertex_colours.hpp"
 
 #include "skinmesh/core/balls.hpp"
 #include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/mesh_io/glb_write.hpp"
+#include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/moving_balls.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
@@ -46,6 +49,43 @@ std::string frame_name(size_t k, const std::string& format);  // frame_0007.ply
 // --format's list: each format once (a frame written twice under one name
 // would collide); throws ContractError naming the repeated one.
 void check_formats(const std::vector<std::string>& formats);
+
+// How the frames are written: the mesh formats (each frame its own file,
+// but glb: every frame in one frames.glb), PLY as text, the colours.
+struct FrameFileOptions {
+  std::vector<std::string> formats{"ply", "vtp"};
+  bool ascii = false;            // PLY as text, for PyMOL 2.5
+  std::string colour = "patch";  // vertex_colours.hpp
+};
+
+// What the frames are written with, and what frames.glb collects.
+struct FrameFiles {
+  FrameFileOptions options;
+  Colouring colouring = Colouring::patch;
+  std::vector<Rgb> source_colours, target_colours;  // per atom of each side (colouring by atom)
+  std::vector<GlbFrame> glb;                        // each frame so far, when glb is asked for
+  static constexpr double glb_seconds_per_frame = 0.1;
+  // Source and target atoms are indices into these (source_atoms.tsv,
+  // target_atoms.tsv, written by stage_atom_tables).
+  FrameFiles(const FrameFileOptions& o, const Molecule& source, const Molecule& target);
+  bool wants(const std::string& format) const;
+  std::string listed_file(size_t k) const;  // what frames.jsonl names: the first per-frame file, or frames.glb
+};
+
+// A frame's per-vertex properties: patch, atom (as the caller means it),
+// id, and from each vertex's (source, target) atom pair, -1 for a side that
+// lacks it: source_atom and target_atom (0 there) with has_source_atom and
+// has_target_atom (0 or 1), and atomid, the source atom where there is one
+// and the target atom otherwise. No atom column is negative; the atom
+// columns and atomid are unsigned.
+VertexAttributes frame_attributes(std::vector<int> patch, std::vector<int> atom, const std::vector<long>& ids,
+                                  const std::vector<std::array<int, 2>>& sides);
+// Frame k in every per-frame format, and kept for frames.glb; colours from `files`.
+void stage_frame_files(OutputSet& outputs, const OutputDirectory& dir, size_t k, const SurfaceMesh& mesh,
+                       VertexAttributes& attributes, const std::vector<std::array<int, 2>>& sides, FrameFiles& files);
+// frames.glb (when asked for), source_atoms.tsv and target_atoms.tsv.
+void stage_frame_set_files(OutputSet& outputs, const OutputDirectory& dir, FrameFiles& files, const Molecule& source,
+                           const Molecule& target);
 // A VTK collection: ParaView opens it as an animation over t.
 void write_pvd(std::ostream& out, const std::vector<double>& times);
 // The share of the triangles whose smallest angle is under the bound (degrees).
@@ -75,10 +115,9 @@ struct MovingFrames {
   std::vector<double> times;
   std::function<std::vector<Ball>(size_t)> balls_of;
   // Per ball: its atom on the source side and on the target side (-1 where
-  // that side lacks it), written per vertex as source_atom and target_atom.
+  // that side lacks it), written per vertex as frame_attributes says.
   std::vector<std::array<int, 2>> ball_atoms;
   MovingOptions options;
-  std::vector<std::string> formats;  // mesh formats per frame
   bool self_intersections = true;    // the exact check on every frame
   std::shared_ptr<ProgressLine> progress;  // null: none
 };
@@ -108,9 +147,9 @@ struct MovingFramesResult {
 // without self-intersections, every vertex within 1e-8 A of the skin of the
 // frame's balls by the static oracle, components, voids and Euler
 // characteristic equal to skin_topology's of those balls) and staged into
-// `outputs` with its balls (frame_NNNN.wpts); `lines` gets frames.jsonl.
-// Stops at the first frame that fails.
-MovingFramesResult run_moving_frames(const MovingFrames& run, OutputSet& outputs, const OutputDirectory& dir,
-                                     std::ostream& lines);
+// `outputs` as `files` says, with its balls (frame_NNNN.wpts); `lines` gets
+// frames.jsonl. Stops at the first frame that fails.
+MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files, OutputSet& outputs,
+                                     const OutputDirectory& dir, std::ostream& lines);
 
 }  // namespace skinmesh::app

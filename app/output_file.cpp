@@ -95,7 +95,10 @@ void check_writable(const std::vector<std::string>& paths) {
   }
   for (const std::string& path : paths) {
     struct stat info {};
-    if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) unusable_output(path, "is a directory");
+    const bool found = ::stat(path.c_str(), &info) == 0;
+    if (found && S_ISDIR(info.st_mode)) unusable_output(path, "is a directory");
+    // The staging file's short name could be written; the rename would fail after the work.
+    if (!found && errno == ENAMETOOLONG) unusable_output(path, "is a longer name than the file system allows");
     remove_stale_staging(std::filesystem::path(path).parent_path());
     const std::string probe = staging_name(path);
     std::ofstream out(probe, std::ios::binary | std::ios::trunc);

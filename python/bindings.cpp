@@ -548,29 +548,33 @@ class PyMorph {
     o.frames = m.frames;
     return o;
   }
+  // Per vertex its atoms as `skinmesh morph` writes them (frame_attributes):
+  // atom and atomid the source atom where there is one, the target atom
+  // otherwise; source_atom, target_atom (0 where the side lacks the atom)
+  // with has_source_atom, has_target_atom.
   Frame current() {
-    std::vector<int> atom, patch;
+    std::vector<std::array<int, 2>> sides;
+    std::vector<int> patch;
+    const MorphFrame& made = matched_ ? moving_->frame() : morph_->frame();
+    const SkinComplex& complex = matched_ ? moving_->complex() : morph_->complex();
+    if (matched_)
+      for (int ball : moving_->vertex_balls()) sides.push_back(ball_atoms_[static_cast<size_t>(ball)]);
+    else
+      sides = morph_->vertex_atoms();
+    for (int c : made.mesh.cells) patch.push_back(complex.cell(c).dim);
+    std::vector<int> atom;
+    for (const auto& [source, target] : sides) atom.push_back(source >= 0 ? source : target);
+    const VertexAttributes a = app::frame_attributes(patch, atom, made.ids, sides);
+    std::vector<Ball> balls;
     if (matched_) {
-      for (int ball : moving_->vertex_balls()) atom.push_back(ball_atoms_[static_cast<size_t>(ball)][0]);
-      for (int c : moving_->frame().mesh.cells) patch.push_back(moving_->complex().cell(c).dim);
-      Frame f = frame_of(moving_->frame(), atom, patch, min_angle_, check_ ? &moving_->balls() : nullptr, shrink_);
-      std::vector<int> target_atom;
-      for (int ball : moving_->vertex_balls()) target_atom.push_back(ball_atoms_[static_cast<size_t>(ball)][1]);
-      f.attributes["target_atom"] = array_of<int, std::int64_t>(target_atom);
-      return f;
+      balls = moving_->balls();
+    } else {  // the blend's balls as a static set: the ends' own, the live pairs' in between
+      const double t = morph_->t();
+      balls = t == 0 ? source_ : t == 1 ? target_ : interpolated_balls(source_, target_, morph_->pairs(), t);
     }
-    std::vector<int> target_atom;
-    for (const auto& pair : morph_->vertex_atoms()) {
-      atom.push_back(pair[0]);
-      target_atom.push_back(pair[1]);
-    }
-    for (int c : morph_->frame().mesh.cells) patch.push_back(morph_->complex().cell(c).dim);
-    // The blend's balls as a static set: the ends' own, the live pairs' in between.
-    const double t = morph_->t();
-    const std::vector<Ball> balls =
-        t == 0 ? source_ : t == 1 ? target_ : interpolated_balls(source_, target_, morph_->pairs(), t);
-    Frame f = frame_of(morph_->frame(), atom, patch, min_angle_, check_ ? &balls : nullptr, shrink_);
-    f.attributes["target_atom"] = array_of<int, std::int64_t>(target_atom);
+    Frame f = frame_of(made, atom, patch, min_angle_, check_ ? &balls : nullptr, shrink_);
+    for (const VertexProperty& column : a.more)
+      if (column.name != "id") f.attributes[column.name.c_str()] = array_of<int, std::int64_t>(column.values);
     return f;
   }
 
@@ -585,7 +589,8 @@ class PyMorph {
 
 // Frames (Morph's or MovingBalls') written as a morph directory, as
 // `skinmesh morph` writes one (docs/morph.md): frame_NNNN.{ply,vtp} with
-// per-vertex id, atom, patch (and target_atom), frames.pvd, frames.jsonl
+// per-vertex id, atom, patch (and a morph's atomid, source_atom,
+// has_source_atom, target_atom, has_target_atom), frames.pvd, frames.jsonl
 // of the frames' reports. All files or none; the directory is made when
 // missing.
 void write_frames(const std::string& directory, const py::iterable& frames, const std::vector<std::string>& formats) {
@@ -611,8 +616,12 @@ void write_frames(const std::string& directory, const py::iterable& frames, cons
     a.patch = ints("patch");
     a.atom = ints("atom");
     std::vector<int> ids(f.ids.data(), f.ids.data() + f.ids.size());
-    a.more = {{"id", ids}};
-    if (f.attributes.contains("target_atom")) a.more.push_back({"target_atom", ints("target_atom")});
+    a.more = {{"id", PropertyType::int32, ids}};
+    // A morph's frame: its atom columns, typed as `skinmesh morph` writes them.
+    for (const auto& [name, type] : {std::pair{"atomid", PropertyType::uint32}, {"source_atom", PropertyType::uint32},
+                                     {"has_source_atom", PropertyType::uint8}, {"target_atom", PropertyType::uint32},
+                                     {"has_target_atom", PropertyType::uint8}})
+      if (f.attributes.contains(name)) a.more.push_back({name, type, ints(name)});
     for (const std::string& format : formats) {
       const std::string name = app::frame_name(k, format);
       outputs.add(dir.file(name), [&](std::ostream& out) { write_mesh(out, mesh, mesh_format_from_path(name), &a); });

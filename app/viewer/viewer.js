@@ -140,19 +140,17 @@
 
   // ---------------------------------------------------------------- per-vertex atoms
 
-  // A vertex's atom on one side, or -1: read by name, and both the old form
-  // (-1 for a side the vertex lacks) and a non-negative form with a flag.
+  // A vertex's atom on one side, or -1: read by name. A frame marks a side
+  // the vertex lacks by has_source_atom or has_target_atom = 0; frames
+  // written before those flags, by -1.
   function sideAtoms(props, side, n) {
-    const names = side === 'mesh' ? ['atom', 'atomid'] : [`${side}_atom`];
-    const column = names.map((k) => props[k]).find((c) => c);
+    const column = side === 'mesh' ? props.atom || props.atomid : props[`${side}_atom`];
+    const present = props[`has_${side}_atom`];
     const out = new Int32Array(n).fill(-1);
     if (!column) return out;
-    const missing = [`${side}_missing`, `no_${side}_atom`, `${side}_atom_missing`].map((k) => props[k]).find((c) => c);
-    const present = [`has_${side}`, `has_${side}_atom`, `${side}_present`].map((k) => props[k]).find((c) => c);
     for (let i = 0; i < n; ++i) {
       const v = column[i];
-      const absent = v < 0 || v >= 4294967295 || (missing && missing[i]) || (present && !present[i]);
-      out[i] = absent ? -1 : v;
+      out[i] = v < 0 || v >= 4294967295 || (present && !present[i]) ? -1 : v;
     }
     return out;
   }

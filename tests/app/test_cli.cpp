@@ -1,5 +1,6 @@
 // The skinmesh command: exit codes and messages a user sees.
 #include "cgal_reference.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 #include "skinmesh/core/interpolation.hpp"
@@ -25,26 +26,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace {
-
-struct Run {
-  int code;
-  std::string output;  // stdout and stderr together
-};
-
-Run run(const std::string& args) {
-  const std::string command = std::string(SKINMESH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string output;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
-}  // namespace
+using skinmesh::test::Run;
+using skinmesh::test::run;
+using skinmesh::test::run_within;
 
 TEST_CASE("skinmesh info reports atoms, radii and the complex", "[cli]") {
   const Run r = run("info " + skinmesh::test::data_file("pept.pdb"));
@@ -442,6 +426,31 @@ TEST_CASE("an empty skin is said to be empty, and non-UTF-8 names do not break -
   CHECK(j["molecule"].get<std::string>().find("\xef\xbf\xbd") != std::string::npos);  // U+FFFD
 }
 
+// B(1e-5) of pept -> 3al1 holds clusters of balls 1e-5 to 1e-3 A apart
+// (pair (i, j) lies t |z_i - z_j| from z_i). The frame took minutes, walks
+// along segments creeping through their sliver cells 1e-9 at a time; it
+// takes about 2 s of CPU. A stall is killed at 60.
+TEST_CASE("morph a step of 1e-5 in t from pept to 3al1 in bounded time", "[cli][morph][bad]") {
+  char pattern[] = "/tmp/skinmesh-near-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = std::string(pattern) + "/out";
+  const Run r = run_within(60, "morph " + skinmesh::test::data_file("pept.pdb") + " " +
+                                   skinmesh::test::data_file("3al1.pdb") + " --t 0,0.00001 --format ply -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  std::ifstream jsonl(dir + "/frames.jsonl");
+  std::string line;
+  int frames = 0;
+  while (std::getline(jsonl, line)) {
+    const nlohmann::json f = nlohmann::json::parse(line);
+    CHECK(f["min_angle"].get<double>() >= 20.0);
+    CHECK(f["max_onsurf_error"].get<double>() <= 1e-9);
+    ++frames;
+  }
+  CHECK(frames == 2);
+  std::filesystem::remove_all(pattern);
+}
+
 TEST_CASE("skinmesh morph writes a self-describing directory of checked frames", "[cli][morph]") {
   char pattern[] = "/tmp/skinmesh-morph-XXXXXX";
   REQUIRE(mkdtemp(pattern) != nullptr);
@@ -463,7 +472,8 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   std::ifstream ply(dir + "/frame_0002.ply");
   std::string header, line;
   while (std::getline(ply, line) && line != "end_header") header += line + "\n";
-  for (const char* property : {"property int id", "property int source_atom", "property int target_atom"})
+  for (const char* property : {"property int id", "property uint atomid", "property uint source_atom",
+                               "property uchar has_source_atom", "property uint target_atom", "property uchar has_target_atom"})
     CHECK(header.find(property) != std::string::npos);
   // frames.jsonl: one object per frame with the fields a user plots.
   std::ifstream jsonl(dir + "/frames.jsonl");
@@ -964,10 +974,18 @@ TEST_CASE("a file name as long as the file system allows is written, and a kille
   char pattern[] = "/tmp/skinmesh-names-XXXXXX";
   REQUIRE(mkdtemp(pattern) != nullptr);
   const std::string dir = pattern;
-  const std::string longest = dir + "/" + std::string(251, 'm') + ".ply";  // a 255-byte name
+  // The longest output is the atom table beside the mesh: a 255-byte name.
+  const std::string longest = dir + "/" + std::string(245, 'm') + ".ply";
   const Run r = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + longest);
   CHECK(r.code == 0);
   CHECK(std::filesystem::exists(longest));
+  CHECK(std::filesystem::exists(dir + "/" + std::string(245, 'm') + ".atoms.tsv"));
+  // One byte more is refused before the work, naming the table, and nothing is written.
+  const std::string over = dir + "/" + std::string(246, 'n') + ".ply";
+  const Run refused = run("--quiet mesh " + skinmesh::test::data_file("pept.pdb") + " -o " + over);
+  CHECK(refused.code == 2);
+  CHECK(refused.output.find(std::string(246, 'n') + ".atoms.tsv: is a longer name") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(over));
   // Staging files: one of a process that is gone, one of this (living) process.
   const pid_t gone = fork();
   REQUIRE(gone >= 0);

@@ -4,25 +4,19 @@
 # 1ubi's mesh with its atom table; the same mesh without one; 2k39 model 1 ->
 # 3 as a morph of 5 frames with both sides' atom tables; its three models as
 # a trajectory (t from 0 to 2); an embedded page of each, and a --no-embed
-# page inside the morph's directory. The atom tables
-# are those the commands write beside their outputs, or where a build writes
-# none, tests/js/atom_table.py's (the rows skinmesh keeps by default, in
-# file order); their row counts are checked against what skinmesh used.
+# page inside the morph's directory. The atom tables are those the commands
+# write beside their outputs; their row counts are checked against the atoms
+# skinmesh used.
 set -euo pipefail
 skinmesh=$1 data=$2 out=$3
-here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$out" && mkdir -p "$out/plain"
 "$skinmesh" --quiet mesh "$data/1ubi.pdb" -o "$out/1ubi.ply"
-# skinmesh's own tables where the command wrote them; else the script's.
-[ -f "$out/1ubi.atoms.tsv" ] || python3 "$here/atom_table.py" "$data/1ubi.pdb" "$out/1ubi.atoms.tsv"
 atoms=$("$skinmesh" --json info "$data/1ubi.pdb" | python3 -c 'import json,sys; print(json.load(sys.stdin)["atoms"])')
 rows=$(($(wc -l < "$out/1ubi.atoms.tsv") - 1))
 [ "$atoms" = "$rows" ] || { echo "1ubi: the atom table has $rows rows, skinmesh kept $atoms atoms" >&2; exit 1; }
 cp "$out/1ubi.ply" "$out/plain/1ubi.ply"
 "$skinmesh" --quiet morph "$data/2k39_3models.pdb" "$data/2k39_3models.pdb" --target-model 3 --frames 5 \
   --pairs matched --format ply -o "$out/morph"
-[ -f "$out/morph/source_atoms.tsv" ] || python3 "$here/atom_table.py" "$data/2k39_3models.pdb" "$out/morph/source_atoms.tsv" --model 1
-[ -f "$out/morph/target_atoms.tsv" ] || python3 "$here/atom_table.py" "$data/2k39_3models.pdb" "$out/morph/target_atoms.tsv" --model 3
 for side in source target; do
   rows=$(($(wc -l < "$out/morph/${side}_atoms.tsv") - 1))
   balls=$(grep -vc "^#" "$out/morph/$side.xyzr")

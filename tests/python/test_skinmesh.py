@@ -45,7 +45,8 @@ def test_mesh_arrays_equal_the_command():
         with open(report) as f:
             command = json.load(f)
         ply = meshio.read(out)
-    assert set(command) - {"command_line", "output", "format"} == set(m.report)  # the report --report writes
+    # the report --report writes, less what only the command knows
+    assert set(command) - {"command_line", "output", "format", "atom_table", "colour"} == set(m.report)
     assert command["quality"] == m.report["quality"]
     assert command["quality"]["vertices"] == len(m.vertices)
     assert command["quality"]["euler_characteristic"] == m.report["quality"]["euler_characteristic"]
@@ -122,7 +123,44 @@ def test_morph_frames_are_valid_and_ids_continue():
     assert not blend.matched
     g = blend.advance_to(0.5)
     assert g.report["guarantees"]["vertices_on_skin"] and g.report["guarantees"]["topology"]
-    assert "target_atom" in g.attributes
+    # As the files hold them: no negative atom value, the missing side a flag
+    # (at t = 1 the blend's mesh is the target's own: no source atoms).
+    for frame, side in ((g, None), (blend.advance_to(1.0), "source")):
+        a = frame.attributes
+        for name in ("atom", "atomid", "source_atom", "target_atom", "has_source_atom", "has_target_atom"):
+            assert a[name].min() >= 0, name
+        assert np.array_equal(a["atomid"], np.where(a["has_source_atom"] == 1, a["source_atom"], a["target_atom"]))
+        if side == "source":
+            assert not a["has_source_atom"].any() and a["has_target_atom"].all()
+
+
+def test_meshio_reads_every_frame_format_with_unsigned_atoms():
+    import xml.etree.ElementTree as ET
+
+    import meshio
+
+    assert BINARY, "SKINMESH_BINARY names the command (ctest sets it)"
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "m")
+        pdb = data("2k39_3models.pdb")
+        subprocess.run([BINARY, "--quiet", "morph", pdb, pdb, "--source-model", "1", "--target-model", "3", "--pairs",
+                        "all", "--frames", "2", "--format", "ply,vtp,off,obj,stl", "-o", out], check=True)
+        for k in (0, 1):
+            missing = "has_target_atom" if k == 0 else "has_source_atom"  # an end frame is one side's own mesh
+            for ext in ("ply", "off", "obj", "stl"):  # meshio 5 has no VTP reader: the VTP is read as XML below
+                m = meshio.read(os.path.join(out, f"frame_000{k}.{ext}"))
+                assert len(m.cells_dict["triangle"]) > 0
+            ply = meshio.read(os.path.join(out, f"frame_000{k}.ply"))
+            for name in ("atomid", "source_atom", "target_atom"):
+                assert ply.point_data[name].dtype.kind == "u", name  # Mol* reads them unsigned
+            assert not ply.point_data[missing].any()
+            arrays = {a.get("Name"): a for a in ET.parse(os.path.join(out, f"frame_000{k}.vtp")).iter("DataArray")}
+            for name in ("atomid", "source_atom", "target_atom"):
+                assert arrays[name].get("type") == "UInt32", name
+            values = np.array(arrays["atomid"].text.split(), dtype=np.int64)
+            assert len(values) == len(ply.points) and values.min() >= 0
+            assert np.array_equal(values, ply.point_data["atomid"])
+            assert not np.array(arrays[missing].text.split(), dtype=np.int64).any()
 
 
 def test_meshio_writes_what_the_module_returns():

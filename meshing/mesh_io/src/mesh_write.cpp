@@ -2,6 +2,7 @@
 #include "skinmesh/core/error.hpp"
 
 #include "skinmesh/core/file_names.hpp"
+#include "skinmesh/mesh_io/glb_write.hpp"
 
 #include <Eigen/Geometry>
 
@@ -22,10 +23,27 @@ Eigen::Vector3d normal_of(const SurfaceMesh& mesh, size_t v) {
 bool has(const VertexAttributes* a, const SurfaceMesh& mesh) {
   if (!a) return false;
   if (a->patch.size() != mesh.vertices.size() || a->atom.size() != mesh.vertices.size()) return false;
-  for (const auto& column : a->more)
-    if (column.second.size() != mesh.vertices.size())
-      contract_error("vertex property " + column.first + ": one value per vertex expected");
+  for (const auto& column : a->more) {
+    if (column.values.size() != mesh.vertices.size())
+      contract_error("vertex property " + column.name + ": one value per vertex expected");
+    if (column.type != PropertyType::int32)
+      for (int v : column.values)
+        if (v < 0 || (column.type == PropertyType::uint8 && v > 255))
+          contract_error("vertex property " + column.name + ": " + std::to_string(v) + " does not fit its unsigned type");
+  }
   return true;
+}
+
+bool has_colours(const VertexAttributes* a, const SurfaceMesh& mesh) {
+  return a && !a->colours.empty() && a->colours.size() == mesh.vertices.size();
+}
+
+const char* ply_type(PropertyType t) {
+  return t == PropertyType::uint8 ? "uchar" : t == PropertyType::uint32 ? "uint" : "int";
+}
+
+const char* vtk_type(PropertyType t) {
+  return t == PropertyType::uint8 ? "UInt8" : t == PropertyType::uint32 ? "UInt32" : "Int32";
 }
 
 template <class T>
@@ -35,43 +53,99 @@ void put(std::ostream& out, T value) {
   out.write(bytes, sizeof(T));
 }
 
+void write_ply_header(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
+                      const MeshWriteOptions& options) {
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  const char* real = options.single_precision ? "float" : "double";
+  out << "ply\nformat " << (options.ascii ? "ascii" : "binary_little_endian") << " 1.0\n"
+      << "comment skinmesh: molecular skin surface\n";
+  out << "element vertex " << mesh.vertices.size() << "\n";
+  for (const char* c : {"x", "y", "z"}) out << "property " << real << " " << c << "\n";
+  if (normals)
+    for (const char* c : {"nx", "ny", "nz"}) out << "property " << real << " " << c << "\n";
+  if (has(attributes, mesh)) {
+    out << "property uchar patch\nproperty int atom\n";
+    for (const auto& column : attributes->more) out << "property " << ply_type(column.type) << " " << column.name << "\n";
+  }
+  if (has_colours(attributes, mesh))
+    for (const char* c : {"red", "green", "blue"}) out << "property uchar " << c << "\n";
+  out << "element face " << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
+// The vertex's values in the header's order, as text or binary.
+template <class Put>
+void write_ply_body(const SurfaceMesh& mesh, const VertexAttributes* attributes, Put& put_value) {
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  const bool attrs = has(attributes, mesh), colours = has_colours(attributes, mesh);
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    for (int k = 0; k < 3; ++k) put_value.real(mesh.vertices[v][k]);
+    if (normals)
+      for (int k = 0; k < 3; ++k) put_value.real(mesh.normals[v][k]);
+    if (attrs) {
+      put_value.integer(PropertyType::uint8, attributes->patch[v]);
+      put_value.integer(PropertyType::int32, attributes->atom[v]);
+      for (const auto& column : attributes->more) put_value.integer(column.type, column.values[v]);
+    }
+    if (colours)
+      for (int k = 0; k < 3; ++k) put_value.integer(PropertyType::uint8, attributes->colours[v][static_cast<size_t>(k)]);
+    put_value.end_line();
+  }
+  for (const auto& t : mesh.triangles) {
+    put_value.integer(PropertyType::uint8, 3);
+    for (int k = 0; k < 3; ++k) put_value.integer(PropertyType::int32, t[static_cast<size_t>(k)]);
+    put_value.end_line();
+  }
+}
+
+struct BinaryPly {
+  std::ostream& out;
+  bool single;
+  void real(double v) {
+    if (single) put(out, static_cast<float>(v));
+    else put(out, v);
+  }
+  void integer(PropertyType type, int v) {
+    if (type == PropertyType::uint8) put(out, static_cast<uint8_t>(v));
+    else if (type == PropertyType::uint32) put(out, static_cast<uint32_t>(v));
+    else put(out, static_cast<int32_t>(v));
+  }
+  void end_line() {}
+};
+
+struct TextPly {
+  std::ostream& out;
+  bool first = true;
+  void separate() {
+    if (!first) out << ' ';
+    first = false;
+  }
+  void real(double v) {
+    separate();
+    out << v;
+  }
+  void integer(PropertyType, int v) {
+    separate();
+    out << v;
+  }
+  void end_line() {
+    out << '\n';
+    first = true;
+  }
+};
+
 void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
                const MeshWriteOptions& options) {
   static_assert(sizeof(float) == 4 && sizeof(double) == 8, "IEEE floating point expected");
   const uint16_t probe = 1;
   if (*reinterpret_cast<const uint8_t*>(&probe) != 1) contract_error("the PLY writer needs a little-endian host");
-  const bool normals = mesh.normals.size() == mesh.vertices.size();
-  const bool attrs = has(attributes, mesh);
-  const char* real = options.single_precision ? "float" : "double";
-  out << "ply\nformat binary_little_endian 1.0\ncomment skinmesh: molecular skin surface\n";
-  out << "element vertex " << mesh.vertices.size() << "\n";
-  for (const char* c : {"x", "y", "z"}) out << "property " << real << " " << c << "\n";
-  if (normals)
-    for (const char* c : {"nx", "ny", "nz"}) out << "property " << real << " " << c << "\n";
-  if (attrs) {
-    out << "property uchar patch\nproperty int atom\n";
-    for (const auto& column : attributes->more) out << "property int " << column.first << "\n";
-  }
-  out << "element face " << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
-  auto real_out = [&](double v) {
-    if (options.single_precision)
-      put(out, static_cast<float>(v));
-    else
-      put(out, v);
-  };
-  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
-    for (int k = 0; k < 3; ++k) real_out(mesh.vertices[v][k]);
-    if (normals)
-      for (int k = 0; k < 3; ++k) real_out(mesh.normals[v][k]);
-    if (attrs) {
-      put(out, static_cast<uint8_t>(attributes->patch[v]));
-      put(out, static_cast<int32_t>(attributes->atom[v]));
-      for (const auto& column : attributes->more) put(out, static_cast<int32_t>(column.second[v]));
-    }
-  }
-  for (const auto& t : mesh.triangles) {
-    put(out, static_cast<uint8_t>(3));
-    for (int k = 0; k < 3; ++k) put(out, static_cast<int32_t>(t[static_cast<size_t>(k)]));
+  write_ply_header(out, mesh, attributes, options);
+  if (options.ascii) {
+    out << std::setprecision(digits(options));
+    TextPly text{out};
+    write_ply_body(mesh, attributes, text);
+  } else {
+    BinaryPly binary{out, options.single_precision};
+    write_ply_body(mesh, attributes, binary);
   }
 }
 
@@ -135,12 +209,12 @@ void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
     out << "</DataArray>\n";
   }
   if (has(attributes, mesh)) {
-    std::vector<std::pair<std::string, const std::vector<int>*>> columns{{"patch", &attributes->patch},
-                                                                         {"atom", &attributes->atom}};
-    for (const auto& column : attributes->more) columns.emplace_back(column.first, &column.second);
-    for (const auto& [name, values] : columns) {
-      out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
-      for (int v : *values) out << v << "\n";
+    std::vector<VertexProperty> columns{{"patch", PropertyType::int32, attributes->patch},
+                                        {"atom", PropertyType::int32, attributes->atom}};
+    columns.insert(columns.end(), attributes->more.begin(), attributes->more.end());
+    for (const auto& [name, type, values] : columns) {
+      out << "<DataArray type=\"" << vtk_type(type) << "\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (int v : values) out << v << "\n";
       out << "</DataArray>\n";
     }
   }
@@ -182,7 +256,8 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (has_extension(path, ".vtp")) return MeshFormat::vtp;
   if (has_extension(path, ".vert")) return MeshFormat::msms;
   if (has_extension(path, ".msh")) return MeshFormat::gmsh;
-  contract_error(path + ": unknown mesh format (use .ply, .off, .obj, .stl, .vtp, .msh, or .vert for MSMS)");
+  if (has_extension(path, ".glb")) return MeshFormat::glb;
+  contract_error(path + ": unknown mesh format (use .ply, .off, .obj, .stl, .vtp, .msh, .glb, or .vert for MSMS)");
 }
 
 const char* mesh_format_name(MeshFormat format) {
@@ -194,6 +269,7 @@ const char* mesh_format_name(MeshFormat format) {
     case MeshFormat::vtp: return "vtp";
     case MeshFormat::msms: return "msms";
     case MeshFormat::gmsh: return "gmsh";
+    case MeshFormat::glb: return "glb";
   }
   return "?";
 }
@@ -207,6 +283,7 @@ void write_mesh(std::ostream& out, const SurfaceMesh& mesh, MeshFormat format, c
     case MeshFormat::obj: write_obj(out, mesh, options); break;
     case MeshFormat::stl: write_stl(out, mesh); break;
     case MeshFormat::vtp: write_vtp(out, mesh, attributes, options); break;
+    case MeshFormat::glb: write_glb(out, {glb_frame(mesh, attributes ? attributes->colours : std::vector<Rgb>{})}); break;
     case MeshFormat::msms: contract_error("MSMS is two files: use write_msms_vert and write_msms_face");
   }
   if (!out) output_error("", "writing the mesh failed");

@@ -6,6 +6,8 @@
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 
+#include <array>
+#include <cstdint>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -13,9 +15,9 @@
 
 namespace skinmesh {
 
-enum class MeshFormat { ply, off, obj, stl, vtp, msms, gmsh };
+enum class MeshFormat { ply, off, obj, stl, vtp, msms, gmsh, glb };
 
-// From the file name: .ply .off .obj .stl .vtp .vert (MSMS: .vert and .face).
+// From the file name: .ply .off .obj .stl .vtp .msh .glb .vert (MSMS: .vert and .face).
 // Throws ContractError for anything else.
 MeshFormat mesh_format_from_path(const std::string& path);
 const char* mesh_format_name(MeshFormat format);
@@ -24,16 +26,30 @@ const char* mesh_format_name(MeshFormat format);
 // MSMS): the patch type (dimension of the mixed cell's Delaunay simplex: 0 and
 // 3 sphere, 1 and 2 hyperboloid) and the owning atom (0-based index into the
 // molecule's atoms).
+// How a further property is typed in the file. Viewers read an atom index
+// as unsigned (Mol* groups a PLY by `atomid` and sizes a table by the
+// largest), so atom columns are uint32 and never hold a negative value.
+enum class PropertyType { int32, uint32, uint8 };
+struct VertexProperty {
+  std::string name;
+  PropertyType type = PropertyType::int32;
+  std::vector<int> values;  // one per vertex; the unsigned types' non-negative (checked when written)
+};
+using Rgb = std::array<std::uint8_t, 3>;  // sRGB, 0-255
+
 struct VertexAttributes {
   std::vector<int> patch;
   std::vector<int> atom;
-  // Further integer properties by name, one value per vertex (a morph frame's
-  // id, source_atom, target_atom); PLY and VTP only.
-  std::vector<std::pair<std::string, std::vector<int>>> more;
+  // Further integer properties, one value per vertex (atomid; a morph
+  // frame's id, source_atom, has_source_atom, ...); PLY and VTP only.
+  std::vector<VertexProperty> more;
+  // Per-vertex colours, or empty: PLY red/green/blue, glTF COLOR_0.
+  std::vector<Rgb> colours;
 };
 
 struct MeshWriteOptions {
   bool single_precision = false;  // PLY float properties, 9 significant digits in text
+  bool ascii = false;             // PLY as text (17 or 9 significant digits): what PyMOL 2.5 reads
 };
 
 // Every format but MSMS, whose two files have their own writers below.
