@@ -1,10 +1,13 @@
 // skinmesh render: a PNG picture of a molecule's skin (meshed first, coloured
-// by patch type, element or chain) or of any mesh file, without a display.
+// by patch type, element or chain) or of any mesh file, or a movie of a
+// morph directory (render_movie.hpp), without a display.
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "molecule_options.hpp"
 #include "output_file.hpp"
 #include "quality_report.hpp"
+#include "render_colours.hpp"
+#include "render_movie.hpp"
 
 #include "skinmesh/core/balls.hpp"
 #include "skinmesh/core/error.hpp"
@@ -15,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -29,18 +33,32 @@ struct RenderCommandOptions {
   std::string output;
   std::string colour = "patch";
   RenderOptions view;
+  MovieOptions movie;  // with --movie: its path, length and rate
 };
 
 void add_render_options(CLI::App& cmd, RenderCommandOptions& o) {
   cmd.add_option("input", o.molecule.path,
-                 "a molecule (meshed with the defaults of `mesh`), or a mesh file (.ply .off .obj .stl .msh .vert)")
+                 "a molecule (meshed with the defaults of `mesh`), a mesh file (.ply .off .obj .stl .msh .vert), or a "
+                 "morph directory (with --movie)")
       ->required();
   add_molecule_settings(cmd, o.molecule);
-  cmd.add_option("--output,-o", o.output, "PNG file")->required();
+  cmd.add_option("--output,-o", o.output, "PNG file (a molecule or a mesh file)");
+  CLI::Option* movie = cmd.add_option("--movie", o.movie.path,
+                                      "a morph directory's movie: .mp4 (H.264) or .webm (VP9), made by ffmpeg; ids "
+                                      "interpolated between frames");
+  cmd.add_option("--seconds", o.movie.seconds, "the movie's length")
+      ->check(finite_number())
+      ->check(CLI::Range(0.04, 3600.0))
+      ->needs(movie);
+  cmd.add_option("--fps", o.movie.fps, "the movie's pictures a second")
+      ->check(finite_number())
+      ->check(CLI::Range(1.0, 120.0))
+      ->needs(movie);
   cmd.add_option("--colour,--color", o.colour,
                  "a molecule's vertices by patch (sphere, saddle, concave), element, chain, or uniform; a mesh file "
-                 "is uniform")
-      ->check(CLI::IsMember({"patch", "element", "chain", "uniform"}));
+                 "is uniform; a movie by patch, age (frames its id has lived), uniform, or chain or element (from "
+                 "the morph's atom tables)")
+      ->check(CLI::IsMember({"patch", "element", "chain", "uniform", "age"}));
   cmd.add_option("--width", o.view.width, "pixels")->check(CLI::Range(16, 8192));
   cmd.add_option("--height", o.view.height, "pixels")->check(CLI::Range(16, 8192));
   cmd.add_option("--yaw", o.view.yaw, "degrees about the vertical axis")->check(finite_number());
@@ -52,22 +70,6 @@ bool is_mesh_file(const std::string& path) {
     if (path.size() > std::string(ext).size() && path.compare(path.size() - std::string(ext).size(), std::string::npos, ext) == 0)
       return true;
   return false;
-}
-
-// A colour per distinct key, from a palette that tells neighbours apart.
-Colour palette(size_t k) {
-  static const Colour colours[] = {{0.38f, 0.62f, 0.85f}, {0.95f, 0.62f, 0.30f}, {0.45f, 0.75f, 0.45f},
-                                   {0.85f, 0.40f, 0.45f}, {0.65f, 0.52f, 0.80f}, {0.70f, 0.60f, 0.45f},
-                                   {0.90f, 0.55f, 0.75f}, {0.60f, 0.60f, 0.60f}};
-  return colours[k % (sizeof colours / sizeof colours[0])];
-}
-
-Colour element_colour(const std::string& element) {  // the usual CPK hues, softened
-  static const std::map<std::string, Colour> known = {{"C", {0.72f, 0.72f, 0.72f}}, {"N", {0.40f, 0.52f, 0.92f}},
-                                                      {"O", {0.92f, 0.38f, 0.35f}}, {"S", {0.95f, 0.85f, 0.35f}},
-                                                      {"P", {0.98f, 0.60f, 0.25f}}, {"H", {0.95f, 0.95f, 0.95f}}};
-  const auto found = known.find(element);
-  return found != known.end() ? found->second : Colour{0.85f, 0.55f, 0.85f};
 }
 
 // The skin of the molecule, meshed, and a colour per vertex.
@@ -98,7 +100,30 @@ SurfaceMesh molecule_mesh(const RenderCommandOptions& o, std::vector<Colour>& co
   return std::move(made.mesh);
 }
 
+ExitCode run_movie(const RenderCommandOptions& o, const GlobalOptions& global) {
+  if (!o.output.empty()) contract_error("render: give --movie or --output, not both");
+  MovieOptions movie = o.movie;
+  movie.colour = o.colour;
+  movie.view = o.view;
+  check_movie(movie, o.molecule.path);
+  check_writable({movie.path});
+  const MovieSummary made = write_movie(movie, o.molecule.path);
+  const json report = {{"input", o.molecule.path}, {"movie", movie.path},     {"width", o.view.width},
+                       {"height", o.view.height},  {"pictures", made.pictures}, {"fps", movie.fps},
+                       {"frames", made.frames},     {"encoder", made.encoder}, {"colour", movie.colour}};
+  if (global.json) std::cout << json_text(report) << "\n";
+  else if (!global.quiet)
+    std::cout << movie.path << ": " << made.pictures << " pictures of " << o.view.width << " x " << o.view.height << " ("
+              << made.encoder << "), " << made.frames << " frames of the morph\n";
+  return ExitCode::ok;
+}
+
 ExitCode run_render(const RenderCommandOptions& o, const GlobalOptions& global) {
+  if (!o.movie.path.empty()) return run_movie(o, global);
+  if (o.output.empty()) contract_error("render: --output (a PNG) is required, or --movie for a morph directory");
+  if (std::filesystem::is_directory(o.molecule.path))
+    contract_error("render: " + o.molecule.path + " is a directory: a morph's is drawn with --movie OUT.mp4");
+  if (o.colour == "age") contract_error("render: --colour age is a morph's (with --movie)");
   check_writable({o.output});
   std::vector<Colour> colours;
   const SurfaceMesh mesh = is_mesh_file(o.molecule.path) ? read_surface_mesh(o.molecule.path) : molecule_mesh(o, colours);

@@ -74,6 +74,7 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& global, int& exit_code
 void add_volume_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_render_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
+void add_view_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_morph_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 void add_trajectory_command(CLI::App& app, const GlobalOptions& global, int& exit_code);
 

@@ -34,6 +34,7 @@ void add_examples(CLI::App& app) {
       {"morph", "skinmesh morph data/2k39_3models.pdb data/2k39_3models.pdb --target-model 3 -o morph/"},
       {"trajectory", "skinmesh trajectory data/2k39_3models.pdb -o ensemble/ --frames-per-step 5"},
       {"render", "skinmesh render data/1ubi.pdb -o ubi.png --colour patch"},
+      {"view", "skinmesh view ubi.ply -o ubi.html"},
   };
   for (const auto& [name, example] : examples) app.get_subcommand(name)->footer(std::string("Example:\n  ") + example);
 }
@@ -63,6 +64,7 @@ int main(int argc, char** argv) {
   skinmesh::app::add_morph_command(app, global, exit_code);
   skinmesh::app::add_trajectory_command(app, global, exit_code);
   skinmesh::app::add_render_command(app, global, exit_code);
+  skinmesh::app::add_view_command(app, global, exit_code);
   add_examples(app);
   try {
     app.parse(argc, argv);

@@ -212,6 +212,8 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"repairs", s.repairs},
           {"edits", {{"split", s.split}, {"flipped", s.flipped}, {"contracted", s.contracted}}},
           {"bad_triangles_after_transport", s.bad_triangles},
+          {"density", s.density},
+          {"thinned", s.thinned},
           {"repaired", s.repaired},
           {"full_rebuild", s.full_rebuild},
           {"max_onsurf_error", c.max_error},

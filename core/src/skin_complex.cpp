@@ -118,9 +118,10 @@ std::array<int, 3> SkinComplex::grid_cell_of(const Eigen::Vector3d& x) const {
 // <z_0 - z_k, 2v - z_0 - z_k> + w_0 - w_k. The plain difference of the two
 // powers loses to cancellation what matters when the balls are close: for
 // centres 1e-9 A apart (a morph's B(t) between nearly equal conformations)
-// its rounding, ~1e-13 of |v|^2, moved the bisector by a tenth of an
-// Angstrom. Here z_0 - z_k and w_0 - w_k are exact when close (Sterbenz).
-double power_gain(const Ball& bk, const Ball& b0, const Eigen::Vector3d& v) {
+// its rounding, ~1e-16 of |v|^2 (1e-13 A^2 at 30 A), over twice the gap can
+// move the bisector by 1e-4 A. Here z_0 - z_k and w_0 - w_k are exact when
+// the balls are close (Sterbenz), and the product keeps its relative accuracy.
+static double power_gain(const Ball& bk, const Ball& b0, const Eigen::Vector3d& v) {
   return (b0.center - bk.center).dot(2.0 * v - b0.center - bk.center) + (b0.weight - bk.weight);
 }
 

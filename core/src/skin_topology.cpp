@@ -1,14 +1,16 @@
-// The dual complex of the union of balls from CGAL's weighted alpha shape
-// (GENERAL mode keeps the singular simplices, exact alpha comparisons keep
-// tangent balls and nearly degenerate sets right). CGAL stays in this file.
+// The dual complex of the union of balls from CGAL's weighted alpha shape at
+// alpha = 0 (Fixed_alpha_shape_3: each simplex classified by exact
+// predicates for that one alpha, which keeps tangent balls and nearly
+// degenerate sets right without the whole alpha spectrum's exact
+// comparisons). CGAL stays in this file.
 #include "skinmesh/core/skin_topology.hpp"
 
 #include "skinmesh/core/error.hpp"
 
-#include <CGAL/Alpha_shape_3.h>
-#include <CGAL/Alpha_shape_cell_base_3.h>
-#include <CGAL/Alpha_shape_vertex_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Fixed_alpha_shape_3.h>
+#include <CGAL/Fixed_alpha_shape_cell_base_3.h>
+#include <CGAL/Fixed_alpha_shape_vertex_base_3.h>
 #include <CGAL/Regular_triangulation_3.h>
 
 #include <Eigen/Core>
@@ -22,11 +24,11 @@ namespace skinmesh {
 namespace {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Alpha_shape_vertex_base_3<K, CGAL::Regular_triangulation_vertex_base_3<K>, CGAL::Tag_true, CGAL::Tag_true>;
-using Cb = CGAL::Alpha_shape_cell_base_3<K, CGAL::Regular_triangulation_cell_base_3<K>, CGAL::Tag_true, CGAL::Tag_true>;
+using Vb = CGAL::Fixed_alpha_shape_vertex_base_3<K, CGAL::Regular_triangulation_vertex_base_3<K>>;
+using Cb = CGAL::Fixed_alpha_shape_cell_base_3<K, CGAL::Regular_triangulation_cell_base_3<K>>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
 using Regular = CGAL::Regular_triangulation_3<K, Tds>;
-using AlphaShape = CGAL::Alpha_shape_3<Regular, CGAL::Tag_true>;
+using AlphaShape = CGAL::Fixed_alpha_shape_3<Regular>;
 
 struct UnionFind {
   std::vector<long> parent;
@@ -97,7 +99,7 @@ SkinTopology skin_topology(const std::vector<Ball>& balls) {
     const Eigen::Vector3d x = mid + far * corner;
     points.emplace_back(K::Point_3(x.x(), x.y(), x.z()), -1.0);
   }
-  const AlphaShape shape(points.begin(), points.end(), 0, AlphaShape::GENERAL);
+  const AlphaShape shape(points.begin(), points.end(), 0);
   // Every simplex of K counts (-1)^dim towards the body's Euler characteristic.
   long vertices = 0, edges = 0, triangles = 0, tetrahedra = 0;
   std::map<AlphaShape::Vertex_handle, long> vertex_index;

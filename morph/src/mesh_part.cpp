@@ -1,9 +1,11 @@
 #include "mesh_part.hpp"
 
+#include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace skinmesh::detail {
@@ -57,6 +59,25 @@ long mark_crowded(const SkinComplex& complex, const SurfaceMesh& mesh, const Mes
       }
     }
   return marked;
+}
+
+double density_over_fresh(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria) {
+  if (mesh.triangles.empty()) return 0;
+  std::vector<double> target(mesh.vertices.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, target.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      target[v] = target_edge_length(complex, mesh.vertices[v], mesh.cells[v], criteria);
+  });
+  double fresh = 0;
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
+    const Eigen::Vector3d& b = mesh.vertices[static_cast<size_t>(t[1])];
+    const Eigen::Vector3d& c = mesh.vertices[static_cast<size_t>(t[2])];
+    const double length = std::min({target[static_cast<size_t>(t[0])], target[static_cast<size_t>(t[1])],
+                                    target[static_cast<size_t>(t[2])]});
+    fresh += 0.5 * (b - a).cross(c - a).norm() / (std::sqrt(3.0) / 4 * length * length);
+  }
+  return static_cast<double>(mesh.triangles.size()) / std::max(fresh, 1.0);
 }
 
 SkinMeshResult remesh_keeping_ids(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,

@@ -24,6 +24,14 @@ SurfaceMesh used_part(const SurfaceMesh& mesh, const std::vector<char>& keep_tri
 long mark_crowded(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria, double below,
                   std::vector<char>& drop);
 
+// How many times denser `mesh` is than a fresh mesh of the same skin would
+// be: its triangle count over the sum, per triangle, of its area divided by
+// the area of an equilateral triangle of the target edge length
+// (`criteria`) at its corners, the size the mesher refines to. About 1 to 2
+// for a mesh the mesher made; transport onto a shrinking skin raises it
+// without bound, as it never removes a vertex.
+double density_over_fresh(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria);
+
 // The frame remeshed from its vertices not marked in `drop` (remesh_skin),
 // those kept carrying their `ids`, new ones taking next_id, next_id + 1, ...
 // `ids` becomes the result's (unchanged when the mesher cannot: status).

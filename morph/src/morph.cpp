@@ -2,6 +2,7 @@
 
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/mesher/triangle_estimate.hpp"
 #include "skinmesh/morph/relaxation.hpp"
 #include "skinmesh/morph/transport.hpp"
 
@@ -98,6 +99,26 @@ void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria, dou
   frame_.ids.resize(frame_.mesh.vertices.size());
   for (long& id : frame_.ids) id = next_id_++;
   frame_.stats.full_rebuild = true;
+}
+
+// More than max_over_fresh times the triangles of a fresh mesh of `next`'s
+// skin, as the mesher estimates it; the estimate (about 0.07 s on
+// ubiquitin) only where the cheap density measure passes the screen.
+bool Morph::too_dense(const SkinComplex& next, const SurfaceMesh& mesh) const {
+  if (!(detail::density_over_fresh(next, mesh, options_.frames) > options_.density_screen)) return false;
+  const TriangleEstimate fresh = estimate_triangles(skin_area_profile(next), options_.frames);
+  return static_cast<double>(mesh.triangles.size()) > options_.max_over_fresh * std::max(fresh.triangles, 1.0);
+}
+
+// The frame meshed afresh because it is too dense (too_dense).
+void Morph::rebuild_thinned(const SkinComplex& next, double t) {
+  const long before = static_cast<long>(frame_.ids.size());
+  const auto start = Clock::now();
+  rebuild(next, options_.repair_criteria(), t);
+  frame_.stats.thinned = true;
+  frame_.stats.inserted = static_cast<long>(frame_.ids.size());
+  frame_.stats.removed = before;
+  frame_.stats.seconds_repair += seconds_since(start);
 }
 
 // Transport (eq. 19) or, off the cell, projection onto the new skin from
@@ -216,6 +237,10 @@ void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
   stats.relocated = static_cast<long>(lost.size()) - stats.lost;
   stats.seconds_transport = seconds_since(transport_start);
   frame_.stats = stats;
+  if (stats.lost == 0 && too_dense(next, moved)) {
+    rebuild_thinned(next, stats.t);
+    return;
+  }
   const auto repair_start = Clock::now();
   remesh_or_rebuild(next, moved, lost);
   frame_.stats.seconds_repair = seconds_since(repair_start);
@@ -232,6 +257,12 @@ void Morph::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved,
 }
 
 void Morph::finish_frame(double t, Clock::time_point start) {
+  frame_.stats.density = detail::density_over_fresh(current_, frame_.mesh, options_.frames);
+  if (!frame_.stats.full_rebuild && frame_.stats.density > options_.density_screen &&
+      too_dense(current_, frame_.mesh)) {
+    rebuild_thinned(current_, t);
+    frame_.stats.density = detail::density_over_fresh(current_, frame_.mesh, options_.frames);
+  }
   t_ = t;
   frame_.stats.t = t;
   frame_.stats.vertices = static_cast<long>(frame_.mesh.vertices.size());
@@ -321,6 +352,15 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
   moved.drop = move_vertices(next, moved.mesh, stats, stayed);
   moved.handled = drop_vanished(t, stayed, moved.mesh, moved.drop, stats);
   stats.seconds_transport = seconds_since(stage_start);
+  // Too dense to be worth mending (a skin that shrank under it): afresh.
+  if (stats.lost == 0 && too_dense(next, moved.mesh)) {
+    frame_.stats = stats;
+    rebuild_thinned(next, t);
+    std::swap(current_, spare_);
+    spare_t_ = -1;
+    finish_frame(t, start);
+    return frame_;
+  }
   if (stats.lost == 0) {
     stage_start = Clock::now();
     if (options_.relaxation.passes > 0) relax_tangentially(next, moved.mesh, options_.relaxation);

@@ -796,7 +796,7 @@ TEST_CASE("the example at the end of every command's help runs as written", "[cl
   const std::string dir = holder.path() + "-examples";
   std::filesystem::create_directory(dir);
   // In the order that makes what a later example reads (quality reads mesh's output).
-  for (const char* command : {"info", "mesh", "quality", "volume", "interpolate", "morph", "trajectory", "render"}) {
+  for (const char* command : {"info", "mesh", "quality", "volume", "interpolate", "morph", "trajectory", "render", "view"}) {
     INFO(command);
     const Run help = run(std::string(command) + " --help");
     const size_t at = help.output.find("Example:\n  ");

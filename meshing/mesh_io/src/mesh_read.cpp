@@ -414,7 +414,8 @@ class PlyValues {
   std::istringstream text_;
 };
 
-SurfaceMesh read_ply(const std::string& path) {
+// `properties`, when given, gets every scalar vertex property but x, y, z by name.
+SurfaceMesh read_ply(const std::string& path, std::map<std::string, std::vector<double>>* properties = nullptr) {
   const std::string data = read_all(path);
   const PlyHeader header = read_ply_header(data, path);
   PlyValues values(data, header, path);
@@ -454,6 +455,7 @@ SurfaceMesh read_ply(const std::string& path) {
         } else {
           const double v = values.next(p.value);
           if (role[k] >= 0) xyz[role[k]] = v;
+          else if (vertex && properties) (*properties)[p.name].push_back(v);
         }
       }
       if (vertex) mesh.vertices.push_back(checked_point(xyz[0], xyz[1], xyz[2], path, 0));
@@ -681,6 +683,12 @@ TetMesh read_tet_mesh(const std::string& path) {
   TetMesh mesh = read_gmsh_volume(path);
   if (mesh.tets.empty()) input_error(path, 0, "no tetrahedra in the file");
   return mesh;
+}
+
+PlyMesh read_ply_with_properties(const std::string& path) {
+  PlyMesh ply;
+  ply.mesh = read_ply(path, &ply.vertex_properties);
+  return ply;
 }
 
 }  // namespace skinmesh

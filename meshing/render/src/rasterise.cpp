@@ -36,23 +36,20 @@ struct Frame {  // the view: rotation, then the fit of the mesh's outline to the
   }
 };
 
-Frame fit(const SurfaceMesh& mesh, const RenderOptions& o) {
-  Frame f;
+Eigen::Matrix3d turn_of(const RenderOptions& o) {
   const double yaw = o.yaw * M_PI / 180, pitch = o.pitch * M_PI / 180;
-  f.turn = (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()))
-               .toRotationMatrix();
+  return (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()))
+      .toRotationMatrix();
+}
+
+Frame fit(const SurfaceMesh& mesh, const RenderOptions& o) {
+  const ViewFit v = o.fit ? *o.fit : fit_view({&mesh}, o);
+  Frame f;
+  f.turn = turn_of(o);
   f.width = o.width * kSamples;
   f.height = o.height * kSamples;
-  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-  for (const auto& p : mesh.vertices) {
-    const Eigen::Vector3d q = f.turn * p;
-    lo = lo.cwiseMin(q.head<2>());
-    hi = hi.cwiseMax(q.head<2>());
-  }
-  f.centre = (lo + hi) / 2;
-  const double margin = o.margin * std::min(f.width, f.height);
-  const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-9);
-  f.scale = std::min((f.width - 2 * margin) / extent.x(), (f.height - 2 * margin) / extent.y());
+  f.centre = {v.centre_x, v.centre_y};
+  f.scale = v.pixels_per_angstrom * kSamples;
   return f;
 }
 
@@ -67,6 +64,22 @@ float shade(const Eigen::Vector3d& n) {
 }
 
 }  // namespace
+
+ViewFit fit_view(const std::vector<const SurfaceMesh*>& meshes, const RenderOptions& o) {
+  const Eigen::Matrix3d turn = turn_of(o);
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (const SurfaceMesh* mesh : meshes)
+    for (const auto& p : mesh->vertices) {
+      const Eigen::Vector3d q = turn * p;
+      lo = lo.cwiseMin(q.head<2>());
+      hi = hi.cwiseMax(q.head<2>());
+    }
+  if (lo.x() > hi.x()) contract_error("fit_view: no vertices to frame");
+  const double margin = o.margin * std::min(o.width, o.height);
+  const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-9);
+  const Eigen::Vector2d centre = (lo + hi) / 2;
+  return {centre.x(), centre.y(), std::min((o.width - 2 * margin) / extent.x(), (o.height - 2 * margin) / extent.y())};
+}
 
 Image render_mesh(const SurfaceMesh& mesh, const RenderOptions& o, const std::vector<Colour>& colours) {
   if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)

@@ -4,7 +4,7 @@
 // design", Discrete Comput. Geom. 21 (1999) 87-115; for every shrink factor
 // in (0,1)). K is the weighted alpha complex at alpha = 0: the simplices of
 // the regular triangulation whose Voronoi faces meet the union. Computed by
-// CGAL's Alpha_shape_3 with exact comparisons, independently of the mixed
+// CGAL's Fixed_alpha_shape_3 (exact predicates), independently of the mixed
 // complex, so that a mesh's topology can be certified against it.
 #pragma once
 

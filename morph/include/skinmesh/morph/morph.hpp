@@ -68,6 +68,15 @@ struct MorphOptions {
   // criteria need). Dimensionless; default 0.5. Lower lets the vertex count
   // grow frame after frame; higher leaves frames coarser, not faster.
   double crowded_below = 0.5;
+  // A frame with more than this many times the triangles a fresh mesh of
+  // its skin would have (the mesher's own estimate, triangle_estimate.hpp)
+  // is meshed afresh, new ids and all: transport onto a shrinking skin never
+  // removes a vertex, and one pass of crowded_below removes too few.
+  // Dimensionless; default 3. Judged only where FrameStats::density, the
+  // cheap measure of every frame, passes density_screen (default 4; a mesh
+  // the mesher made measures 2-3).
+  double max_over_fresh = 3.0;
+  double density_screen = 4.0;
   // Local repair is tried when at most this share of the triangles fails
   // after transport (a share, 0-1; default 0.01; 0: never); past it the
   // patches cover much of the mesh and remeshing the whole frame from its
@@ -113,7 +122,9 @@ struct FrameStats {
   long removed = 0;            // vertices of the previous frame not in this one
   long repairs = 0;            // refinement insertions, each at a failing triangle
   long split = 0, flipped = 0, contracted = 0;  // edits that mended failing triangles
-  bool full_rebuild = false;   // the frame was meshed from scratch (repair failed)
+  bool full_rebuild = false;   // the frame was meshed from scratch (repair failed, or too dense)
+  double density = 0;          // triangles over those a fresh mesh of the frame's skin would have (2-3 fresh)
+  bool thinned = false;        // meshed afresh (full_rebuild): more than max_over_fresh times a fresh mesh's triangles
   // Moving balls (moving_balls.hpp) only:
   long steps = 0;              // internal steps since the frame before (each a complex built from scratch)
   long reidentified = 0;       // vertices that moved farther than continuity allows and took a new id
@@ -171,6 +182,8 @@ class Morph {
                              const MorphOptions& options);
   Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
         const MorphOptions& options);
+  bool too_dense(const SkinComplex& next, const SurfaceMesh& mesh) const;
+  void rebuild_thinned(const SkinComplex& next, double t);
   void rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t);
   void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);

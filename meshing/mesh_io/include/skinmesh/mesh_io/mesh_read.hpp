@@ -7,7 +7,9 @@
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/core/tet_mesh.hpp"
 
+#include <map>
 #include <string>
+#include <vector>
 
 namespace skinmesh {
 
@@ -16,6 +18,15 @@ namespace skinmesh {
 // into triangles. STL corners are merged when their coordinates are identical.
 // Throws InputError naming the file and line.
 SurfaceMesh read_surface_mesh(const std::string& path);
+
+// A PLY file with its per-vertex scalar properties kept by name (a mesh's
+// `patch` and `atom`, a morph frame's `id`, `source_atom`, `target_atom`,
+// normals...), each one value per vertex, as doubles. Throws InputError.
+struct PlyMesh {
+  SurfaceMesh mesh;
+  std::map<std::string, std::vector<double>> vertex_properties;  // every scalar one but x, y, z
+};
+PlyMesh read_ply_with_properties(const std::string& path);
 
 // A tetrahedral mesh: TetGen's .node/.ele/.face set (any one of the three
 // names; the .face file is optional) with regions from the first .ele
