@@ -30,6 +30,7 @@ struct QualityCommandOptions {
   std::string mesh;
   std::string svg;
   bool no_self_intersections = false;
+  double max_box_pairs = kDefaultBoxPairsPerTriangle;  // per triangle, on average
   bool tetgen = false;
   MoleculeOptions molecule;
 };
@@ -39,6 +40,11 @@ void add_quality_options(CLI::App& cmd, QualityCommandOptions& o) {
   cmd.add_option("--molecule", o.molecule.path, "also measure each vertex's distance to this molecule's skin");
   cmd.add_option("--svg", o.svg, "write a histogram of the smallest angles as SVG");
   cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
+  cmd.add_option("--max-box-pairs", o.max_box_pairs,
+                 "refuse a mesh whose self-intersection check meets more than this many pairs of triangles with "
+                 "overlapping boxes per triangle (a skin mesh has about 6)")
+      ->check(finite_number())->check(positive_number())
+      ->capture_default_str();
   cmd.add_flag("--tetgen", o.tetgen, "also count self-intersections with TetGen's -d check (a second opinion)");
   add_molecule_settings(cmd, o.molecule);
 }
@@ -61,10 +67,23 @@ void grade_tets(const std::string& file, const TetMesh& tets, const GlobalOption
             << report["marked_faces_not_on_boundary"].get<long>() << " marked faces not on a boundary\n";
 }
 
-void grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, const GlobalOptions& global) {
+// A mesh whose triangles overlap far more than a surface's: the check would
+// take time (and, counted, pairs) growing as the square of its size.
+ExitCode refuse_box_pairs(const QualityCommandOptions& o, const GradeOptions& grade, const MeshQuality& q) {
+  std::cerr << "skinmesh: error: " << o.mesh << ": the self-intersection check stopped after " << q.self_intersection_box_pairs
+      << " pairs of triangles with overlapping bounding boxes, more than its bound of "
+      << grade.max_box_pairs(q.triangles) << " (" << o.max_box_pairs << " per triangle, --max-box-pairs; a skin mesh has "
+      << "about 6): its triangles pile on each other. Raise --max-box-pairs to count them all, or grade the "
+      << "rest with --no-self-intersections\n";
+  return ExitCode::not_met;
+}
+
+ExitCode grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, const GlobalOptions& global) {
   GradeOptions grade;
   grade.self_intersections = o.no_self_intersections ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
+  grade.max_box_pairs_per_triangle = o.max_box_pairs;
   const MeshQuality q = grade_mesh(mesh, grade);
+  if (q.self_intersections_over_bound) return refuse_box_pairs(o, grade, q);
   json report = to_json(q);
   report["file"] = o.mesh;
   if (o.tetgen) {
@@ -83,7 +102,7 @@ void grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, cons
   if (!o.svg.empty()) write_file_atomically(o.svg, [&](std::ostream& out) { write_svg(out, q, o.mesh); });
   if (global.json) {
     std::cout << json_text(report) << "\n";
-    return;
+    return ExitCode::ok;
   }
   print_quality_summary(std::cout, o.mesh, q);
   if (report.contains("tetgen_self_intersecting_triangles"))
@@ -95,6 +114,7 @@ void grade_surface(const QualityCommandOptions& o, const SurfaceMesh& mesh, cons
   if (report.contains("on_surface_error"))
     std::cout << "  on-surface error: max " << report["on_surface_error"]["max"].get<double>() << " A, mean "
               << report["on_surface_error"]["mean"].get<double>() << " A (oracle, " << o.molecule.path << ")\n";
+  return ExitCode::ok;
 }
 
 // Tetrahedral meshes (TetGen's files, or a Gmsh file with tetrahedra) are
@@ -119,8 +139,7 @@ ExitCode run_quality(const QualityCommandOptions& o, const GlobalOptions& global
   } else {
     mesh = read_surface_mesh(o.mesh);
   }
-  grade_surface(o, mesh, global);
-  return ExitCode::ok;
+  return grade_surface(o, mesh, global);
 }
 
 }  // namespace

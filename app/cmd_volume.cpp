@@ -14,6 +14,7 @@
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/tet_quality.hpp"
+#include "skinmesh/volume/tet_estimate.hpp"
 #include "skinmesh/volume/volume_mesh.hpp"
 
 #include <nlohmann/json.hpp>
@@ -60,7 +61,7 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
       ->check(finite_number())->check(non_negative_number())
       ->capture_default_str();
   cmd.add_option("--max-tetrahedra", o.volume.max_tetrahedra,
-                 "refuse a --max-volume that asks for more tetrahedra than this (domain volume / max volume)")
+                 "refuse at once a job whose estimate of TetGen's tetrahedra passes this")
       ->check(positive_number())
       ->capture_default_str();
   cmd.add_flag("--drop-cavities", o.drop_cavities, "fill enclosed voids instead of keeping their surfaces");
@@ -69,8 +70,8 @@ void add_volume_options(CLI::App& cmd, VolumeCommandOptions& o) {
       ->capture_default_str();
   cmd.add_option("--edge-length", o.meshing.edge_length, "surface: largest edge length, A (0: none, curvature only)")->check(finite_number())->check(non_negative_number())->capture_default_str();
   cmd.add_option("--max-memory", o.max_memory_gb,
-                 "refuse at once a skin mesh whose estimated memory passes this many GB, and stop TetGen past it "
-                 "(0: the memory available now)")
+                 "refuse at once a skin mesh or a TetGen run whose estimated memory passes this many GB, and stop "
+                 "TetGen past it (0: the memory available now)")
       ->check(finite_number())->check(non_negative_number())
       ->capture_default_str();
   cmd.add_option("--max-seconds", o.volume.max_seconds, "stop TetGen past this many seconds (0: no bound)")
@@ -98,6 +99,8 @@ json volume_report(const VolumeCommandOptions& o, const VolumeOptions& volume, c
   // The interior's tetrahedra fill exactly what the skin encloses (its
   // outer components minus kept cavities): the grader's signed volume.
   report["enclosed_volume"] = sq.volume;
+  report["estimated_tetrahedra"] = {{"expected", std::llround(made.estimated_tetrahedra)},
+                                    {"low", std::llround(made.estimated_low)}};
   const bool bounds_met =
       q.max_radius_edge <= volume.bounds.max_radius_edge && q.min_dihedral >= volume.bounds.min_dihedral;
   report["bounds"] = {{"max_radius_edge", volume.bounds.max_radius_edge}, {"min_dihedral", volume.bounds.min_dihedral}};
@@ -137,6 +140,36 @@ void print_volume_summary(const VolumeCommandOptions& o, const VolumeOptions& vo
             << report["enclosed_volume"].get<double>() << " A^3\n";
 }
 
+// The five volume files and the report, all or none.
+void write_volume_files(const VolumeCommandOptions& o, const TetMesh& mesh, const json& report) {
+  OutputSet outputs;
+  outputs.add(o.output + ".vtu", [&](std::ostream& out) { write_vtu(out, mesh); });
+  outputs.add(o.output + ".msh", [&](std::ostream& out) { write_gmsh(out, mesh); });
+  outputs.add(o.output + ".node", [&](std::ostream& out) { write_tetgen_node(out, mesh); });
+  outputs.add(o.output + ".ele", [&](std::ostream& out) { write_tetgen_ele(out, mesh); });
+  outputs.add(o.output + ".face", [&](std::ostream& out) { write_tetgen_face(out, mesh); });
+  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << json_text(report) << "\n"; });
+  outputs.commit();
+}
+
+// The outer box alone, before the skin is meshed: the atoms' centres lie
+// inside the skin, so their bounding box is inside the skin's, and the box's
+// estimate without the skin's triangles or the volume bound is a low end of
+// the full one. A margin whose box TetGen could not hold is refused at once,
+// however long the molecule would take to mesh. Empty when it fits.
+std::string box_refusal(const std::vector<Ball>& balls, const VolumeOptions& volume) {
+  if (volume.domain == VolumeDomain::interior) return "";
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (const Ball& b : balls)
+    if (b.weight > 0) lo = lo.cwiseMin(b.center), hi = hi.cwiseMax(b.center);
+  if (!(lo.x() <= hi.x())) return "";
+  TetDomain box;
+  box.extent = hi - lo;
+  VolumeOptions without_volume_bound = volume;
+  without_volume_bound.max_volume = 0;
+  return tet_budget_refusal(box, without_volume_bound);
+}
+
 ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   std::vector<std::string> outputs_to_write;
@@ -146,6 +179,12 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
   if (m.atoms.empty()) input_error(o.molecule.path, 0, "no atoms left to mesh");
   const auto balls = balls_from_molecule(m, o.molecule.shrink, o.molecule.convention());
+  VolumeOptions volume = volume_options(o);
+  volume.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
+  if (const std::string too_big = box_refusal(balls, volume); !too_big.empty()) {
+    std::cerr << "skinmesh: error: " << o.molecule.path << ": " << too_big << "\n";
+    return ExitCode::not_met;
+  }
   const SkinComplex complex = build_skin_complex(balls, {o.molecule.shrink});
   MeshingOptions meshing = o.meshing;
   meshing.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
@@ -167,8 +206,6 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
               << json_text(guarantees_json(g)) << "\n";
     return ExitCode::not_met;
   }
-  VolumeOptions volume = volume_options(o);
-  volume.max_memory_bytes = memory_limit_bytes(o.max_memory_gb);
   if (progress) std::cerr << "skinmesh: " << surface.mesh.triangles.size() << " skin triangles; running TetGen\n";
   const VolumeMeshResult made = tetrahedralize(surface.mesh, volume);
   if (made.status != VolumeStatus::ok) {
@@ -178,14 +215,7 @@ ExitCode run_volume(const VolumeCommandOptions& o, const GlobalOptions& global) 
   const TetQuality q = grade_tet_mesh(made.mesh);
   const long tetgen_triangles = tetgen_self_intersections(surface.mesh);
   const json report = volume_report(o, volume, made, q, g.quality, tetgen_triangles);
-  OutputSet outputs;
-  outputs.add(o.output + ".vtu", [&](std::ostream& out) { write_vtu(out, made.mesh); });
-  outputs.add(o.output + ".msh", [&](std::ostream& out) { write_gmsh(out, made.mesh); });
-  outputs.add(o.output + ".node", [&](std::ostream& out) { write_tetgen_node(out, made.mesh); });
-  outputs.add(o.output + ".ele", [&](std::ostream& out) { write_tetgen_ele(out, made.mesh); });
-  outputs.add(o.output + ".face", [&](std::ostream& out) { write_tetgen_face(out, made.mesh); });
-  if (!o.report.empty()) outputs.add(o.report, [&](std::ostream& out) { out << json_text(report) << "\n"; });
-  outputs.commit();
+  write_volume_files(o, made.mesh, report);
   if (global.json) std::cout << json_text(report) << "\n";
   else if (!global.quiet) print_volume_summary(o, volume, q, report);
   return ExitCode::ok;

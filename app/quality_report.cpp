@@ -47,6 +47,8 @@ nlohmann::json to_json(const MeshQuality& q) {
           {"unused_vertices", q.unused_vertices},
           {"self_intersections_checked", q.self_intersections_checked},
           {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
+          {"self_intersection_box_pairs", q.self_intersection_box_pairs},
+          {"self_intersections_over_bound", q.self_intersections_over_bound},
           {"min_angle_histogram", {{"lo_deg", q.min_angle_histogram.lo},
                                    {"hi_deg", q.min_angle_histogram.hi},
                                    {"counts", q.min_angle_histogram.counts}}}};
@@ -103,8 +105,10 @@ void print_quality_summary(std::ostream& out, const std::string& name, const Mes
       << " non-manifold edges, " << q.nonmanifold_vertices << " non-manifold vertices, " << q.inconsistent_edges
       << " inconsistently oriented edges, " << q.degenerate_triangles << " zero-area triangles\n"
       << "  self-intersections: "
-      << (q.self_intersections_checked ? std::to_string(q.self_intersecting_pairs) + " pairs"
-                                       : std::string("not checked (needs a manifold, oriented mesh)"))
+      << (q.self_intersections_checked     ? std::to_string(q.self_intersecting_pairs) + " pairs"
+          : q.self_intersections_over_bound ? "not checked (stopped after " + std::to_string(q.self_intersection_box_pairs) +
+                                                  " pairs of overlapping boxes)"
+                                            : std::string("not checked (needs a manifold, oriented mesh)"))
       << "\n";
 }
 

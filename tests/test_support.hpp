@@ -113,4 +113,25 @@ inline SurfaceMesh two_interpenetrating_tetrahedra() {
   return two;
 }
 
+// `copies` closed unit-edge tetrahedra, oriented outward, their centres
+// drawn (seeded) in a cube of side `side` A: a closed oriented manifold (by
+// index) whose triangles, when the cube is small, nearly all cross each
+// other, so that its self-intersecting pairs grow as the square of its size.
+inline SurfaceMesh pile_of_tetrahedra(int copies, double side, unsigned seed) {
+  SurfaceMesh pile;
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> at(0, side);
+  const double h = 0.5 / std::sqrt(2.0);
+  for (int i = 0; i < copies; ++i) {
+    const Eigen::Vector3d c(at(random), at(random), at(random));
+    const int base = static_cast<int>(pile.vertices.size());
+    for (const Eigen::Vector3d& p : {Eigen::Vector3d(h, h, h), Eigen::Vector3d(h, -h, -h), Eigen::Vector3d(-h, h, -h),
+                                     Eigen::Vector3d(-h, -h, h)})
+      pile.vertices.push_back(c + p);
+    for (const std::array<int, 3>& t : {std::array<int, 3>{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}})
+      pile.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+  }
+  return pile;
+}
+
 }  // namespace skinmesh::test

@@ -29,11 +29,29 @@ inline Run run_shell(const std::string& command) {
 
 inline Run run(const std::string& args) { return run_shell(std::string(SKINMESH_BINARY) + " " + args + " 2>&1"); }
 
-// As run(), under a limit of `cpu_seconds` of CPU time: a run that stalls is
-// killed (SIGXCPU) and reports code -1.
-inline Run run_within(int cpu_seconds, const std::string& args) {
-  return run_shell("ulimit -t " + std::to_string(cpu_seconds) + "; exec " + std::string(SKINMESH_BINARY) + " " +
-                   args + " 2>&1");
+// Whether this build runs under AddressSanitizer, which reserves terabytes
+// of address space for its shadow memory: no address-space limit leaves it
+// room to start.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kAddressSanitizer = true;
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+
+// As run(), under a limit of `cpu_seconds` of CPU time and, when
+// `memory_mb` is set, of that many MB of address space (not under
+// AddressSanitizer: see above): a run that stalls is killed (SIGXCPU) and
+// reports code -1; one that passes the memory limit fails an allocation.
+inline Run run_within(int cpu_seconds, const std::string& args, long memory_mb = 0) {
+  std::string limits = "ulimit -t " + std::to_string(cpu_seconds) + "; ";
+  if (memory_mb > 0 && !kAddressSanitizer) limits += "ulimit -v " + std::to_string(memory_mb * 1024) + "; ";
+  return run_shell(limits + "exec " + std::string(SKINMESH_BINARY) + " " + args + " 2>&1");
 }
 
 }  // namespace skinmesh::test

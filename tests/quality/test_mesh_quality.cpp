@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -192,6 +193,37 @@ TEST_CASE("self-intersections: folds between neighbours count as CGAL counts the
     CHECK(count_self_intersections(folded) == expected);
   }
   CHECK(count_self_intersections(flat) == 0);
+}
+
+TEST_CASE("self-intersections: a pile of bodies is counted as CGAL counts it, or stopped at the bound", "[quality]") {
+  // 300 tetrahedra in a 1 A cube: most pairs of their triangles have
+  // overlapping boxes, and many of those cross.
+  const SurfaceMesh pile = test::pile_of_tetrahedra(300, 1.0, 5);
+  const long expected = test::cgal_self_intersecting_pairs(pile);
+  REQUIRE(expected > 100'000);
+  const SelfIntersectionCount all = check_self_intersections(pile, std::numeric_limits<long>::max());
+  CHECK_FALSE(all.over_bound);
+  CHECK(all.pairs == expected);
+  CHECK(all.box_pairs >= expected);
+  // A bound below the pairs there are stops the check, which then says so.
+  const SelfIntersectionCount bounded = check_self_intersections(pile, all.box_pairs / 10);
+  CHECK(bounded.over_bound);
+  CHECK(bounded.box_pairs < all.box_pairs);
+  // Through the grader: at 1 pair per triangle the floor of a million is the
+  // bound, which this pile passes; the mesh is graded all the same, with
+  // its self-intersections not checked.
+  GradeOptions tight;
+  tight.max_box_pairs_per_triangle = 1;
+  const SurfaceMesh bigger = test::pile_of_tetrahedra(1500, 1.0, 5);
+  const MeshQuality q = grade_mesh(bigger, tight);
+  CHECK(q.self_intersections_over_bound);
+  CHECK_FALSE(q.self_intersections_checked);
+  CHECK(q.closed);
+  CHECK(q.components == 1500);
+  // A surface meets the default bound with room to spare.
+  const MeshQuality ring = grade_mesh(torus(400, 60, 3.0, 1.0));
+  CHECK(ring.self_intersections_checked);
+  CHECK(ring.self_intersection_box_pairs < 20 * ring.triangles);
 }
 
 TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {

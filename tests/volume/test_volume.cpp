@@ -9,7 +9,9 @@
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 #include "skinmesh/quality/tet_quality.hpp"
+#include "skinmesh/volume/tet_estimate.hpp"
 #include "skinmesh/volume/volume_mesh.hpp"
+#include "tetgen_run.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -329,10 +331,11 @@ TEST_CASE("TetGen runs in memory: its errors and an oversized volume bound are s
 
   // A volume bound that asks for more tetrahedra than the budget is refused
   // before TetGen runs, naming the bound that would fit, which then runs.
+  // (Without a volume bound the estimate's low end is about 21,000.)
   const SurfaceMesh skin = skin_mesh(test::data_file("pept.pdb"));
   VolumeOptions tiny;
   tiny.max_volume = 0.05;
-  tiny.max_tetrahedra = 20'000;
+  tiny.max_tetrahedra = 40'000;
   const VolumeMeshResult refused = tetrahedralize(skin, tiny);
   INFO(refused.message);
   REQUIRE(refused.status == VolumeStatus::over_budget);
@@ -344,7 +347,85 @@ TEST_CASE("TetGen runs in memory: its errors and an oversized volume bound are s
   const VolumeMeshResult made = tetrahedralize(skin, fits);
   INFO(made.message);
   REQUIRE(made.status == VolumeStatus::ok);
-  // The estimate is a lower bound: TetGen made at least that many.
+  // The estimate's low end is a lower bound: TetGen made at least that many.
   const double enclosed = grade_mesh(skin).volume;
   CHECK(static_cast<double>(made.mesh.tets.size()) >= enclosed / fits.max_volume);
+  CHECK(static_cast<double>(made.mesh.tets.size()) >= estimate_tetrahedra(tet_domain(skin, enclosed), fits).low);
+}
+
+TEST_CASE("the estimate of TetGen's tetrahedra: its low end below the count, the count near it", "[volume][estimate]") {
+  // pept's interior at the defaults, at the tightest radius-edge bound and
+  // at the loosest bounds; its solvent in a box 20 A out; with a volume bound.
+  const SurfaceMesh skin = skin_mesh(test::data_file("pept.pdb"));
+  const TetDomain domain = tet_domain(skin, grade_mesh(skin).volume);
+  std::vector<VolumeOptions> cases(5);
+  cases[1].bounds.max_radius_edge = 1.5;
+  cases[2].bounds.max_radius_edge = 10, cases[2].bounds.min_dihedral = 0;
+  cases[3].domain = VolumeDomain::exterior, cases[3].box_margin = 20;
+  cases[4].max_volume = 0.1;
+  for (const VolumeOptions& o : cases) {
+    const TetEstimate e = estimate_tetrahedra(domain, o);
+    const VolumeMeshResult made = tetrahedralize(skin, o);
+    REQUIRE(made.status == VolumeStatus::ok);
+    const double count = static_cast<double>(made.mesh.tets.size());
+    CAPTURE(o.bounds.max_radius_edge, o.bounds.min_dihedral, o.box_margin, o.max_volume, e.tetrahedra, e.low, count);
+    CHECK(count >= e.low);
+    CHECK(count <= kTetEstimateSpread * e.tetrahedra);
+  }
+  // The box's triangles as add_box makes them: 4 (nx ny + ny nz + nz nx)
+  // for a grid of n cells of at most 3 A a side, whatever the margin.
+  CHECK(box_triangles(Eigen::Vector3d(3, 6, 9), 0) == 4 * (1 * 2 + 2 * 3 + 3 * 1));
+  CHECK(box_triangles(Eigen::Vector3d(1, 1, 1), 1e12) > 1e23);
+}
+
+// Named "out of memory ...": scripts/sanitize.sh leaves it out, since an
+// address-space limit does not bind AddressSanitizer's allocator.
+TEST_CASE("out of memory in TetGen's child: stopped at its bound, whatever the estimate", "[volume][bad][oom]") {
+  // The estimate refuses what it sees coming; the run's own bound is for
+  // what it does not. 1ubi's interior at TetGen's tightest bounds is some
+  // 2 million tetrahedra, hundreds of MB (more than this process may have
+  // freed for the child to reuse); 10 MB are allowed.
+  const SurfaceMesh skin = skin_mesh(test::data_file("1ubi.pdb"));
+  detail::Plc plc;
+  plc.points = skin.vertices;
+  plc.facets = skin.triangles;
+  plc.markers.assign(skin.triangles.size(), kFaceSkin);
+  const detail::TetgenRun bounded = detail::run_tetgen(plc, "pzYQq1.2/18", {10e6, 0});
+  CHECK(bounded.error.find("TetGen ran out of the memory allowed (0.010 GB, --max-memory)") != std::string::npos);
+  CHECK(bounded.mesh.tets.empty());
+}
+
+TEST_CASE("a box or a quality bound past the budget is refused before TetGen, naming what fits", "[volume][bad]") {
+  const SurfaceMesh skin = skin_mesh(test::data_file("pept.pdb"));
+  VolumeOptions wide;
+  wide.domain = VolumeDomain::exterior;
+  wide.box_margin = 40;
+  wide.max_tetrahedra = 30'000;
+  const VolumeMeshResult refused = tetrahedralize(skin, wide);
+  INFO(refused.message);
+  REQUIRE(refused.status == VolumeStatus::over_budget);
+  const size_t at = refused.message.find("this would fit: --box-margin ");
+  REQUIRE(at != std::string::npos);
+  VolumeOptions fits = wide;
+  fits.box_margin = std::stod(refused.message.substr(at + 29));
+  CHECK(fits.box_margin < wide.box_margin);
+  const VolumeMeshResult made = tetrahedralize(skin, fits);
+  INFO(made.message);
+  CHECK(made.status == VolumeStatus::ok);
+  // The memory bound binds the same way.
+  VolumeOptions small = wide;
+  small.max_tetrahedra = 10'000'000;
+  small.max_memory_bytes = 1e6;
+  const VolumeMeshResult no_room = tetrahedralize(skin, small);
+  INFO(no_room.message);
+  CHECK(no_room.status == VolumeStatus::over_budget);
+  CHECK(no_room.message.find("the memory allowed (0.001 GB, --max-memory)") != std::string::npos);
+  // An interior with no box and no volume bound: only the quality bounds
+  // are left to loosen.
+  VolumeOptions tight;
+  tight.max_tetrahedra = 1'000;
+  const VolumeMeshResult none = tetrahedralize(skin, tight);
+  INFO(none.message);
+  CHECK(none.status == VolumeStatus::over_budget);
+  CHECK(none.message.find("loosen --min-dihedral or --max-radius-edge") != std::string::npos);
 }

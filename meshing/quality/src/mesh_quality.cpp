@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace skinmesh {
@@ -245,6 +246,11 @@ SurfaceMesh outer_surface(const SurfaceMesh& mesh, std::vector<int>* kept_from) 
   return out;
 }
 
+long GradeOptions::max_box_pairs(long triangles) const {
+  const double bound = max_box_pairs_per_triangle * static_cast<double>(triangles);
+  return bound >= 9e18 ? std::numeric_limits<long>::max() : std::max(kMinBoxPairs, static_cast<long>(bound));
+}
+
 MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
   MeshQuality q;
   // The parts write different fields of q and run side by side. The exact
@@ -252,12 +258,14 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
   // used only if the mesh turns out manifold, oriented and without
   // degenerate triangles (given a degenerate one it returns at once).
   const bool exact = options.self_intersections == SelfIntersectionCheck::exact;
-  long pairs = -1;
+  SelfIntersectionCount crossing;
   SurfaceComponents components;
   tbb::parallel_invoke([&] { grade_triangles(mesh, q); }, [&] { grade_edges(mesh, q); },
                        [&] { grade_vertices(mesh, q); }, [&] { components = surface_components(mesh); },
                        [&] {
-                         if (exact) pairs = count_self_intersections(mesh);
+                         if (exact)
+                           crossing = check_self_intersections(
+                               mesh, options.max_box_pairs(static_cast<long>(mesh.triangles.size())));
                        });
   q.components = static_cast<long>(components.enclosed_volume.size());
   q.euler = q.vertices - q.edges + q.triangles;
@@ -271,8 +279,10 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
     for (int c = 0; c < static_cast<int>(q.components); ++c) q.cavities += components.is_cavity(c);
   }
   if (exact && q.manifold && q.oriented && q.degenerate_triangles == 0) {
-    q.self_intersections_checked = pairs >= 0;
-    q.self_intersecting_pairs = std::max(0L, pairs);
+    q.self_intersections_checked = !crossing.degenerate && !crossing.over_bound;
+    q.self_intersections_over_bound = crossing.over_bound;
+    q.self_intersection_box_pairs = crossing.box_pairs;
+    q.self_intersecting_pairs = q.self_intersections_checked ? crossing.pairs : 0;
   }
   return q;
 }

@@ -10,7 +10,8 @@
 
 #include <algorithm>
 #include <array>
-#include <utility>
+#include <atomic>
+#include <limits>
 #include <vector>
 
 namespace skinmesh {
@@ -79,11 +80,12 @@ Box box_of(const SurfaceMesh& mesh, int f) {
 // The triangles cut into `slabs` ranges of x at quantiles of their boxes'
 // middles; a triangle goes to every slab its x extent meets, so every pair
 // whose boxes meet lies wholly in a slab (the one holding an x both reach).
-std::vector<std::vector<const Box*>> cut_into_slabs(const std::vector<Box>& boxes, size_t slabs) {
+std::vector<std::vector<const Box*>> cut_into_slabs(const std::vector<Box>& boxes, size_t slabs,
+                                                   std::vector<double>& cut) {
   std::vector<double> middle;
   middle.reserve(boxes.size());
   for (const Box& b : boxes) middle.push_back(0.5 * (b.min_coord(0) + b.max_coord(0)));
-  std::vector<double> cut;  // slab k is [cut[k-1], cut[k]], the outer ones open
+  cut.clear();  // slab k is [cut[k-1], cut[k]], the outer ones open
   for (size_t k = 1; k < slabs; ++k) {
     auto at = middle.begin() + static_cast<long>(middle.size() * k / slabs);
     std::nth_element(middle.begin(), at, middle.end());
@@ -99,38 +101,89 @@ std::vector<std::vector<const Box*>> cut_into_slabs(const std::vector<Box>& boxe
   return slab;
 }
 
+// Past the bound on box pairs, the callback throws this to leave CGAL's
+// box intersection at once.
+struct OverBound {};
+
+// What the slabs share: the box pairs examined so far, against the bound.
+struct BoxPairs {
+  long max = 0;
+  std::atomic<long> seen{0};
+  std::atomic<bool> over{false};
+};
+
+// A pair's boxes both reach x = max of their lower x ends: the slab holding
+// that x, the one slab of those holding both that counts the pair, so that a
+// pair found in two slabs is counted once without storing any pair.
+size_t owner_slab(const std::vector<double>& cut, const Box& a, const Box& b) {
+  const double x = std::max(a.min_coord(0), b.min_coord(0));
+  return static_cast<size_t>(std::lower_bound(cut.begin(), cut.end(), x) - cut.begin());
+}
+
+// The crossing pairs slab k of `cut`'s slabs owns (CGAL sorts the slab's
+// boxes in place); stops (over set) when the slabs together pass the bound
+// on box pairs.
+long count_slab(const SurfaceMesh& mesh, std::vector<const Box*>& slab, size_t k, const std::vector<double>& cut,
+                BoxPairs& shared) {
+  long crossing = 0, unreported = 0;  // box pairs of this slab not yet added to shared.seen
+  const auto on_pair = [&](const Box* x, const Box* y) {
+    // The shared count is updated in batches: an atomic add per pair would
+    // cost more than most pairs' predicates.
+    if (++unreported == 4096) {
+      if (shared.seen.fetch_add(unreported) + unreported > shared.max || shared.over) throw OverBound{};
+      unreported = 0;
+    }
+    if (!cut.empty() && owner_slab(cut, *x, *y) != k) return;
+    const auto& a = mesh.triangles[static_cast<size_t>(x->info())];
+    const auto& b = mesh.triangles[static_cast<size_t>(y->info())];
+    crossing += triangles_cross(mesh, a, b);
+  };
+  try {
+    // CGAL's cutoff below which a range is scanned instead of split: 2,000,
+    // as CGAL's own self-intersection test uses (smaller ones were slower).
+    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(slab.begin(), slab.end(), on_pair, std::ptrdiff_t{2000});
+    shared.seen += unreported;
+  } catch (const OverBound&) {
+    shared.over = true;
+  }
+  return crossing;
+}
+
 }  // namespace
 
 // CGAL's own parallel mode shuffles the boxes and was slower here. Instead
 // the slabs are checked each as a task of its own (beside the oracle's, so
-// the cores share them); pairs found in two slabs are counted once.
-long count_self_intersections(const SurfaceMesh& mesh) {
+// the cores share them). Pairs are counted, never stored: a mesh whose
+// triangles nearly all cross (thousands of copies of one body) has a number
+// of crossing pairs that grows as the square of its size.
+SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max_box_pairs) {
+  SelfIntersectionCount result;
   for (const auto& t : mesh.triangles)
-    if (degenerate(mesh, t)) return -1;
+    if (degenerate(mesh, t)) {
+      result.degenerate = true;
+      return result;
+    }
   std::vector<Box> boxes;
   boxes.reserve(mesh.triangles.size());
   for (size_t f = 0; f < mesh.triangles.size(); ++f) boxes.push_back(box_of(mesh, static_cast<int>(f)));
   // Two slabs from 180,000 triangles, else one: each slab costs the box
   // intersection more than its share, and more slabs were slower.
   const size_t slabs = std::clamp<size_t>(boxes.size() / 90000, 1, 2);
-  std::vector<std::vector<const Box*>> slab = cut_into_slabs(boxes, slabs);
-  std::vector<std::vector<std::pair<int, int>>> found(slabs);
-  tbb::parallel_for(size_t{0}, slabs, [&](size_t k) {
-    // CGAL's cutoff below which a range is scanned instead of split: 2,000,
-    // as CGAL's own self-intersection test uses (smaller ones were slower).
-    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(
-        slab[k].begin(), slab[k].end(),
-        [&](const Box* x, const Box* y) {
-          const auto& a = mesh.triangles[static_cast<size_t>(x->info())];
-          const auto& b = mesh.triangles[static_cast<size_t>(y->info())];
-          if (triangles_cross(mesh, a, b)) found[k].emplace_back(std::minmax(x->info(), y->info()));
-        },
-        std::ptrdiff_t{2000});
-  });
-  std::vector<std::pair<int, int>> pairs;
-  for (const auto& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
-  std::sort(pairs.begin(), pairs.end());
-  return static_cast<long>(std::unique(pairs.begin(), pairs.end()) - pairs.begin());
+  std::vector<double> cut;
+  std::vector<std::vector<const Box*>> slab = cut_into_slabs(boxes, slabs, cut);
+  std::vector<long> crossing(slabs, 0);
+  BoxPairs shared;
+  shared.max = max_box_pairs;
+  tbb::parallel_for(size_t{0}, slabs, [&](size_t k) { crossing[k] = count_slab(mesh, slab[k], k, cut, shared); });
+  result.box_pairs = shared.seen;
+  result.over_bound = shared.over || result.box_pairs > max_box_pairs;
+  for (long c : crossing) result.pairs += c;
+  return result;
+}
+
+long count_self_intersections(const SurfaceMesh& mesh) {
+  const SelfIntersectionCount c = check_self_intersections(mesh, std::numeric_limits<long>::max());
+  return c.degenerate ? -1 : c.pairs;
 }
 
 }  // namespace skinmesh

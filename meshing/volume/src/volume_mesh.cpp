@@ -11,6 +11,7 @@
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 #include "skinmesh/quality/tet_quality.hpp"
+#include "skinmesh/volume/tet_estimate.hpp"
 
 #include "tetgen_run.hpp"
 
@@ -110,29 +111,6 @@ Box box_around(const std::vector<Eigen::Vector3d>& points, const std::vector<std
   return b;
 }
 
-// The volume TetGen fills (Angstrom^3): what the skin encloses, the outer
-// box less that, or the whole box.
-double domain_volume(const SurfaceMesh& surface, double enclosed, const VolumeOptions& options) {
-  if (options.domain == VolumeDomain::interior) return enclosed;
-  const Box b = box_around(surface.vertices, surface.triangles, options.box_margin);
-  const double box = (b.hi - b.lo).prod();
-  return options.domain == VolumeDomain::both ? box : box - enclosed;
-}
-
-// A volume bound that asks for more tetrahedra than the budget: the message,
-// with the bound that would fit; empty when it fits.
-std::string over_budget(double volume, const VolumeOptions& options) {
-  if (!(options.max_volume > 0)) return "";
-  const double at_least = volume / options.max_volume;
-  if (at_least <= static_cast<double>(options.max_tetrahedra)) return "";
-  std::ostringstream out;
-  out << "a largest tetrahedron of " << options.max_volume << " A^3 asks for at least " << std::llround(at_least)
-      << " tetrahedra (" << volume << " A^3 to fill), more than the budget of " << options.max_tetrahedra
-      << "; a --max-volume of at least " << volume / static_cast<double>(options.max_tetrahedra)
-      << " A^3 fits (or raise --max-tetrahedra)";
-  return out.str();
-}
-
 // The surface's triangles (less the filled cavities) with their markers, and a
 // region or hole point for every component kept. Returns a message when a
 // component has no point beside it.
@@ -169,11 +147,8 @@ std::string add_surface(const SurfaceMesh& surface_in, const VolumeOptions& opti
 }
 
 // The outer box `margin` beyond the surface's bounding box, each side a grid
-// of triangles about kBoxSpacing across (TetGen may not split boundary facets
-// (-Y), so two huge triangles a side would leave slivers against them), and
-// the solvent's region point.
+// of triangles about kBoxSpacing across, and the solvent's region point.
 void add_box(double margin, Plc& plc) {
-  constexpr double kBoxSpacing = 3.0;
   const Box box = box_around(plc.points, plc.facets, margin);
   const Eigen::Vector3d lo = box.lo, hi = box.hi;  // named, not bound: lambdas below capture them
   const Eigen::Vector3d extent = hi - lo;
@@ -229,6 +204,14 @@ VolumeMeshResult failed(VolumeStatus status, std::string message) {
   return r;
 }
 
+// What keeps a surface from bounding a volume.
+std::string not_closed(const MeshQuality& q) {
+  return "the surface is not a closed, consistently oriented manifold (" + std::to_string(q.boundary_edges) +
+         " boundary, " + std::to_string(q.nonmanifold_edges) + " non-manifold and " +
+         std::to_string(q.inconsistent_edges) + " inconsistently oriented edges, " +
+         std::to_string(q.nonmanifold_vertices) + " non-manifold vertices)";
+}
+
 // TetGen's switches: -p a piecewise linear complex; -z zero-based; -A region
 // attributes; -Y no Steiner points on the surface; -Q quiet; -q quality bounds.
 // TetGen cannot split a tetrahedron whose refinement point would land on the
@@ -239,8 +222,7 @@ VolumeMeshResult failed(VolumeStatus status, std::string message) {
 // terminate, so the tightened request stays inside those.
 std::string tetgen_switches(const VolumeOptions& options) {
   std::ostringstream switches;
-  switches << "pzAYQq" << std::max(1.2, kTetgenTightening * options.bounds.max_radius_edge) << '/'
-           << std::min(options.bounds.min_dihedral + 5.0, 18.0);
+  switches << "pzAYQq" << tetgen_ratio(options.bounds) << '/' << tetgen_dihedral(options.bounds);
   if (options.max_volume > 0) switches << 'a' << options.max_volume;
   return switches.str();
 }
@@ -264,6 +246,9 @@ VolumeMeshResult run_tetgen(const Plc& plc, const VolumeOptions& options) {
 
 }  // namespace
 
+double tetgen_ratio(const TetBounds& bounds) { return std::max(1.2, kTetgenTightening * bounds.max_radius_edge); }
+double tetgen_dihedral(const TetBounds& bounds) { return std::min(bounds.min_dihedral + 5.0, 18.0); }
+
 const char* volume_status_name(VolumeStatus status) {
   switch (status) {
     case VolumeStatus::ok: return "ok";
@@ -282,20 +267,19 @@ VolumeMeshResult tetrahedralize(const SurfaceMesh& surface, const VolumeOptions&
   GradeOptions topology_only;
   topology_only.self_intersections = SelfIntersectionCheck::skip;
   const MeshQuality q = grade_mesh(surface, topology_only);
-  if (!(q.closed && q.manifold && q.oriented))
-    return failed(VolumeStatus::surface_not_closed,
-                  "the surface is not a closed, consistently oriented manifold (" + std::to_string(q.boundary_edges) +
-                      " boundary, " + std::to_string(q.nonmanifold_edges) + " non-manifold and " +
-                      std::to_string(q.inconsistent_edges) + " inconsistently oriented edges, " +
-                      std::to_string(q.nonmanifold_vertices) + " non-manifold vertices)");
-  const std::string too_many = over_budget(domain_volume(surface, q.volume, options), options);
+  if (!(q.closed && q.manifold && q.oriented)) return failed(VolumeStatus::surface_not_closed, not_closed(q));
+  const TetDomain domain = tet_domain(surface, q.volume);
+  const std::string too_many = tet_budget_refusal(domain, options);
   if (!too_many.empty()) return failed(VolumeStatus::over_budget, too_many);
+  const TetEstimate estimate = estimate_tetrahedra(domain, options);
   Plc plc;
   const std::string missing = add_surface(surface, options, plc);
   if (!missing.empty()) return failed(VolumeStatus::surface_not_closed, missing);
   if (options.domain != VolumeDomain::interior) add_box(options.box_margin, plc);
   const auto started = std::chrono::steady_clock::now();
   VolumeMeshResult result = run_tetgen(plc, options);
+  result.estimated_tetrahedra = estimate.tetrahedra;
+  result.estimated_low = estimate.low;
   // TetGen's commonest input error, named (checked only when it failed).
   if (result.status == VolumeStatus::tetgen_failed) {
     const long crossing = count_self_intersections(surface);
