@@ -138,7 +138,7 @@ void write_glb(std::ostream& out, const std::vector<GlbFrame>& frames, const std
   Builder b;
   json meshes = json::array(), nodes = json::array(), scene_nodes = json::array();
   for (size_t k = 0; k < frames.size(); ++k) {
-    meshes.push_back({{"name", frames[k].name}, {"primitives", {primitive_of(b, frames[k])}}});
+    meshes.push_back({{"name", frames[k].name}, {"primitives", json::array({primitive_of(b, frames[k])})}});
     json node = {{"name", frames[k].name}, {"mesh", k}};
     if (frames.size() > 1 && k > 0) node["scale"] = {0.0, 0.0, 0.0};  // before the animation plays: frame 0
     nodes.push_back(node);
@@ -149,15 +149,18 @@ void write_glb(std::ostream& out, const std::vector<GlbFrame>& frames, const std
   const json base = coloured ? json{1.0, 1.0, 1.0, 1.0} : json{0.342, 0.509, 0.745, 1.0};
   json doc = {{"asset", {{"version", "2.0"}, {"generator", generator}}},
               {"scene", 0},
-              {"scenes", {{{"nodes", scene_nodes}}}},
+              {"scenes", json::array({json{{"nodes", scene_nodes}}})},
               {"nodes", nodes},
               {"meshes", meshes},
-              {"materials", {{{"name", "skin"},
-                              {"pbrMetallicRoughness",
-                               {{"baseColorFactor", base}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.7}}}}}}};
-  if (frames.size() > 1) doc["animations"] = {visibility_animation(b, frames)};
+              {"materials", json::array({json{{"name", "skin"},
+                                              {"pbrMetallicRoughness",
+                                               {{"baseColorFactor", base}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.7}}}}})}};
+  // Arrays of one element are spelt json::array: a braced list of one json
+  // value is that value's copy under clang (an object where glTF wants an
+  // array), its array under GCC.
+  if (frames.size() > 1) doc["animations"] = json::array({visibility_animation(b, frames)});
   while (b.bin.size() % 4) b.bin.push_back(0);
-  doc["buffers"] = {{{"byteLength", b.bin.size()}}};
+  doc["buffers"] = json::array({json{{"byteLength", b.bin.size()}}});
   doc["bufferViews"] = b.views;
   doc["accessors"] = b.accessors;
   std::string text = doc.dump(-1, ' ', false, json::error_handler_t::replace);
