@@ -44,12 +44,19 @@ inline constexpr bool kAddressSanitizer = false;
 inline constexpr bool kAddressSanitizer = false;
 #endif
 
-// As run(), under a limit of `cpu_seconds` of CPU time and, when
-// `memory_mb` is set, of that many MB of address space (not under
-// AddressSanitizer: see above): a run that stalls is killed (SIGXCPU) and
-// reports code -1; one that passes the memory limit fails an allocation.
+// How many times longer the command runs in this build: the sanitizers'
+// build (scripts/sanitize.sh, -O1 with AddressSanitizer and
+// UndefinedBehaviorSanitizer) ran the property test's morphs past 4 times
+// their CPU time in the release build.
+inline constexpr int kSlowdown = kAddressSanitizer ? 8 : 1;
+
+// As run(), under a limit of `cpu_seconds` of CPU time (as the release build
+// runs; kSlowdown times that here) and, when `memory_mb` is set, of that
+// many MB of address space (not under AddressSanitizer: see above): a run
+// that stalls is killed (SIGXCPU) and reports code -1; one that passes the
+// memory limit fails an allocation.
 inline Run run_within(int cpu_seconds, const std::string& args, long memory_mb = 0) {
-  std::string limits = "ulimit -t " + std::to_string(cpu_seconds) + "; ";
+  std::string limits = "ulimit -t " + std::to_string(cpu_seconds * kSlowdown) + "; ";
   if (memory_mb > 0 && !kAddressSanitizer) limits += "ulimit -v " + std::to_string(memory_mb * 1024) + "; ";
   return run_shell(limits + "exec " + std::string(SKINMESH_BINARY) + " " + args + " 2>&1");
 }
