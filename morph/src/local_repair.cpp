@@ -1,5 +1,6 @@
 #include "local_repair.hpp"
 
+#include "judge.hpp"
 #include "mesh_part.hpp"
 
 #include <tbb/blocked_range.h>
@@ -255,28 +256,6 @@ void compact(const SurfaceMesh& merged, size_t old_vertices, LocalRepair& out) {
 }
 
 }  // namespace
-
-bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,
-                     const MeshingOptions& criteria) {
-  const auto restricted = restricted_triangle(complex, corners, criteria.tolerance, hint);
-  return restricted && triangle_defect(complex, *restricted, criteria) == TriangleDefect::none &&
-         faces_outward(complex, *restricted);
-}
-
-std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
-                                    const std::vector<Triangle>& triangles, const MeshingOptions& criteria) {
-  std::vector<char> bad(triangles.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
-      const Triangle& t = triangles[i];
-      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
-                                                   mesh.vertices[static_cast<size_t>(t[1])],
-                                                   mesh.vertices[static_cast<size_t>(t[2])]};
-      bad[i] = !triangle_passes(complex, corners, mesh.cells[static_cast<size_t>(t[0])], criteria);
-    }
-  });
-  return bad;
-}
 
 namespace {
 

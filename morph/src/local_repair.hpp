@@ -69,17 +69,4 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, 
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options);
 
-// Whether a triangle of a frame meets the criteria (restricted_triangle,
-// triangle_defect) and faces outward (faces_outward): the criteria alone do
-// not see a triangle that transport turned over (a vertex moved across its
-// neighbours). Judged at the surface ball centre, not by its corners'
-// normals: across a thin neck a good triangle's corner normals can turn
-// past a right angle from its own. hint: a cell near the triangle.
-bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,
-                     const MeshingOptions& criteria);
-
-// Per triangle, 1 where it fails triangle_passes, in parallel.
-std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
-                                    const std::vector<std::array<int, 3>>& triangles, const MeshingOptions& criteria);
-
 }  // namespace skinmesh::detail

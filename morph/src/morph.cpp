@@ -6,6 +6,7 @@
 #include "skinmesh/morph/relaxation.hpp"
 #include "skinmesh/morph/transport.hpp"
 
+#include "judge.hpp"
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
 #include "surgery.hpp"

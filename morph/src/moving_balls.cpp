@@ -3,6 +3,7 @@
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"
 
+#include "judge.hpp"
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
 #include "surgery.hpp"

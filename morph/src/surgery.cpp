@@ -1,5 +1,6 @@
 #include "surgery.hpp"
 
+#include "judge.hpp"
 #include "mesh_part.hpp"
 
 #include <Eigen/Geometry>
@@ -41,8 +42,6 @@ struct EdgeKeyHash {
     return static_cast<size_t>(x ^ (x >> 31));
   }
 };
-
-enum class Verdict { pass, size, shape, inward, other };
 
 double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d u = (a - apex).normalized(), w = (b - apex).normalized();
@@ -145,21 +144,10 @@ std::vector<int> Editor::ring(int v) const {
   return out;
 }
 
-// The frame's criteria, as detail::triangle_passes applies them, with the
-// kind of failure: size and distance are mended by a split, shape first by
-// a contraction or a flip.
+// The frame's criteria with the kind of failure (judge.hpp).
 Verdict Editor::judge(int f) const {
   const Triangle& t = tri(f);
-  const std::array<Eigen::Vector3d, 3> corners{at(t[0]), at(t[1]), at(t[2])};
-  const auto restricted = restricted_triangle(complex_, corners, accept_.tolerance, mesh_.cells[static_cast<size_t>(t[0])]);
-  if (!restricted) return Verdict::other;
-  switch (triangle_defect(complex_, *restricted, accept_)) {
-    case TriangleDefect::none: return faces_outward(complex_, *restricted) ? Verdict::pass : Verdict::inward;
-    case TriangleDefect::size:
-    case TriangleDefect::distance: return Verdict::size;
-    case TriangleDefect::shape: return Verdict::shape;
-    default: return Verdict::other;
-  }
+  return judge_triangle(complex_, {at(t[0]), at(t[1]), at(t[2])}, mesh_.cells[static_cast<size_t>(t[0])], accept_);
 }
 
 // Edge a -> b is not locally Delaunay: the angles opposite it add up to more

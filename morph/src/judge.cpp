@@ -1,0 +1,36 @@
+#include "judge.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace skinmesh::detail {
+
+Verdict judge_triangle(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,
+                       const MeshingOptions& criteria) {
+  const auto restricted = restricted_triangle(complex, corners, criteria.tolerance, hint);
+  if (!restricted) return Verdict::other;
+  switch (triangle_defect(complex, *restricted, criteria)) {
+    case TriangleDefect::none: return faces_outward(complex, *restricted) ? Verdict::pass : Verdict::inward;
+    case TriangleDefect::size:
+    case TriangleDefect::distance: return Verdict::size;
+    case TriangleDefect::shape: return Verdict::shape;
+    default: return Verdict::other;
+  }
+}
+
+std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                    const std::vector<std::array<int, 3>>& triangles, const MeshingOptions& criteria) {
+  std::vector<char> bad(triangles.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const std::array<int, 3>& t = triangles[i];
+      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
+                                                   mesh.vertices[static_cast<size_t>(t[1])],
+                                                   mesh.vertices[static_cast<size_t>(t[2])]};
+      bad[i] = !triangle_passes(complex, corners, mesh.cells[static_cast<size_t>(t[0])], criteria);
+    }
+  });
+  return bad;
+}
+
+}  // namespace skinmesh::detail

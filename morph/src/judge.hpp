@@ -1,0 +1,40 @@
+// The one judge of a morph frame's triangles (private to morph/): the
+// frame criteria of the static mesher (restricted_triangle,
+// triangle_defect) plus the orientation a transported triangle can lose.
+// Every rung of the repair (edits, local patch, whole-frame remesh) and both
+// engines (Morph, MovingBalls) ask it, so a triangle passes or fails the same
+// way wherever it is judged.
+#pragma once
+
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
+#include "skinmesh/mesher/skin_mesher.hpp"
+
+#include <array>
+#include <vector>
+
+namespace skinmesh::detail {
+
+// What a triangle fails, grouped by how the edits mend it: size and
+// distance by a split, shape first by a contraction or a flip; a triangle
+// turned inward or not restricted (`other`) by neither.
+enum class Verdict : char { pass, size, shape, inward, other };
+
+// The criteria alone do not see a triangle that transport turned over (a
+// vertex moved across its neighbours): it is judged by faces_outward at its
+// surface ball centre, not by its corners' normals (across a thin neck a
+// good triangle's corner normals can turn past a right angle from its own).
+// hint: a cell near the triangle.
+Verdict judge_triangle(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,
+                       const MeshingOptions& criteria);
+
+inline bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::Vector3d, 3>& corners, int hint,
+                            const MeshingOptions& criteria) {
+  return judge_triangle(complex, corners, hint, criteria) == Verdict::pass;
+}
+
+// Per triangle of `triangles` (corners in `mesh`), 1 where it does not pass, in parallel.
+std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                    const std::vector<std::array<int, 3>>& triangles, const MeshingOptions& criteria);
+
+}  // namespace skinmesh::detail
