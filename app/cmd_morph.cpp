@@ -341,9 +341,7 @@ MovingOptions moving_options(const MorphOptions& m) {
   o.frames = m.frames;
   o.first_size_margin = m.first_size_margin;
   o.relaxation = m.relaxation;
-  o.edits = m.edits;
-  o.crowded_below = m.crowded_below;
-  o.local_repair_share = m.local_repair_share;
+  o.repair = m.repair;
   return o;
 }
 

@@ -81,8 +81,8 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
   const auto start = Clock::now();
   MorphOptions options;
   if (!local_repair) {  // c': every failing frame remeshed whole (no edits, no patches)
-    options.local_repair_share = 0;
-    options.edits = false;
+    options.repair.patch.max_failing_share = 0;
+    options.repair.edits.enabled = false;
   }
   Morph morph = prepare_morph(p.source, p.target, ts.front(), options);
   c.seconds_first = seconds_since(start);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -98,6 +99,10 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
   return std::sqrt(longest2);
 }
 
+// Attempts a patch always gets (PatchPolicy::attempts permitting) before it
+// may give up for want of progress.
+constexpr int kAttemptsBeforeGivingUp = 4;
+
 // Vertices near the patch that the mesh does not join to it (another sheet
 // across a thin gap, the far side of a narrow neck) become context too.
 // Without them the Voronoi edge of a patch facet runs on across the gap, its
@@ -105,14 +110,29 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
 // a second time: the repair fails (a wrong topology, or too many points)
 // and the whole frame is remeshed. Near: within twice the longest edge of the
 // region's triangles, about the diameter of a patch facet's surface
-// Delaunay ball.
-void add_nearby_context(const SurfaceMesh& mesh, const std::vector<char>& region, std::vector<signed char>& role) {
+// Delaunay ball, and no farther than `cap` target lengths at the patch
+// vertex (infinite: no cap).
+void add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& region,
+                        const MeshingOptions& criteria, double cap, std::vector<signed char>& role) {
   // A region of seeds alone (a newborn component) takes the mesh's longest edge.
   double longest = longest_edge(mesh, region);
   if (!(longest > 0)) longest = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
-  const double reach = 2 * longest;
-  if (!(reach > 0)) return;
-  auto cell_of = [&](const Eigen::Vector3d& p) -> Eigen::Vector3i { return (p / reach).array().floor().cast<int>(); };
+  if (!(longest > 0)) return;
+  const auto context = static_cast<signed char>(PatchRole::context);
+  std::vector<double> reach(role.size(), 0.0);
+  std::vector<double> reaches;
+  for (size_t v = 0; v < role.size(); ++v) {
+    if (role[v] == kNone || role[v] == context) continue;
+    reach[v] = 2 * longest;
+    if (std::isfinite(cap))
+      reach[v] = std::min(reach[v], cap * target_edge_length(complex, mesh.vertices[v], mesh.cells[v], criteria));
+    reaches.push_back(reach[v]);
+  }
+  if (reaches.empty()) return;
+  // Grid cells as wide as the median reach: most vertices search 27 cells.
+  std::nth_element(reaches.begin(), reaches.begin() + static_cast<long>(reaches.size() / 2), reaches.end());
+  const double cell = reaches[reaches.size() / 2];
+  auto cell_of = [&](const Eigen::Vector3d& p) -> Eigen::Vector3i { return (p / cell).array().floor().cast<int>(); };
   auto key = [](const Eigen::Vector3i& c) {  // 21 bits a coordinate
     return (int64_t{c.x()} & 0x1FFFFF) | ((int64_t{c.y()} & 0x1FFFFF) << 21) | ((int64_t{c.z()} & 0x1FFFFF) << 42);
   };
@@ -120,22 +140,46 @@ void add_nearby_context(const SurfaceMesh& mesh, const std::vector<char>& region
   for (int v = 0; v < static_cast<int>(mesh.vertices.size()); ++v)
     if (role[static_cast<size_t>(v)] == kNone) grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
   // Marked at once, each vertex once: gathered in a list first, a vertex
-  // came once for every patch vertex near it, and one stretched triangle
-  // makes the reach long, so the list could outgrow the rest of the morph.
-  const auto context = static_cast<signed char>(PatchRole::context);
+  // came once for every patch vertex near it, and the list could outgrow
+  // the rest of the morph.
   for (size_t v = 0; v < role.size(); ++v) {
-    if (role[v] == kNone || role[v] == context) continue;
+    if (!(reach[v] > 0)) continue;
     const Eigen::Vector3d& p = mesh.vertices[v];
-    const Eigen::Vector3i c = cell_of(p);
-    for (int k = 0; k < 27; ++k) {
-      const auto it = grid.find(key(c + Eigen::Vector3i(k % 3 - 1, k / 3 % 3 - 1, k / 9 - 1)));
-      if (it == grid.end()) continue;
-      for (int w : it->second) {
+    const auto mark = [&](const std::vector<int>& near) {
+      for (int w : near) {
         signed char& r = role[static_cast<size_t>(w)];
-        if (r == kNone && (mesh.vertices[static_cast<size_t>(w)] - p).squaredNorm() < reach * reach) r = context;
+        if (r == kNone && (mesh.vertices[static_cast<size_t>(w)] - p).squaredNorm() < reach[v] * reach[v]) r = context;
       }
-    }
+    };
+    const int span = static_cast<int>(std::ceil(reach[v] / cell));
+    const Eigen::Vector3i c = cell_of(p);
+    for (int i = -span; i <= span; ++i)
+      for (int j = -span; j <= span; ++j)
+        for (int k = -span; k <= span; ++k) {
+          const auto it = grid.find(key(c + Eigen::Vector3i(i, j, k)));
+          if (it != grid.end()) mark(it->second);
+        }
   }
+}
+
+// The context of a patch (add_nearby_context). One triangle that transport
+// stretched across a pinching neck is many target lengths long, and with
+// it as the measure the context of a large patch took most of the frame
+// (70-86% of the vertices of 3mht in bench_moving's DNA motion), each
+// attempt then costing about a remesh of the whole frame. Past a quarter
+// of the frame the reach is capped at six target lengths. A small patch
+// keeps the uncapped reach: on small molecules the far context is what
+// lets a stretched patch succeed.
+void add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& region,
+                 const MeshingOptions& criteria, std::vector<signed char>& role) {
+  constexpr double kLargeShare = 0.25;       // of the frame's vertices
+  constexpr double kCapInTargetLengths = 6;  // dimensionless
+  const std::vector<signed char> patch = role;
+  add_nearby_context(complex, mesh, region, criteria, std::numeric_limits<double>::infinity(), role);
+  const auto taken = std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; });
+  if (static_cast<double>(taken) <= kLargeShare * static_cast<double>(role.size())) return;
+  role = patch;
+  add_nearby_context(complex, mesh, region, criteria, kCapInTargetLengths, role);
 }
 
 // Interior vertices crowded together along a patch edge: the later one goes.
@@ -312,13 +356,13 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   Attempt a;
   std::vector<signed char> role = vertex_roles(mesh, stars, region);
   for (size_t v = seeds_from; v < role.size(); ++v) role[v] = static_cast<signed char>(PatchRole::interior);
-  add_nearby_context(mesh, region, role);
+  add_context(complex, mesh, region, accept, role);
   const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, options.crowded_below);
   std::vector<PatchRole> roles;
   std::vector<int> index;
   const std::vector<SkinSample> samples = patch_samples(mesh, role, drop, roles, index);
   // Nearly the whole frame: no faults, so the caller remeshes it whole.
-  if (static_cast<double>(samples.size()) > options.max_sample_share * static_cast<double>(mesh.vertices.size())) {
+  if (static_cast<double>(samples.size()) > options.policy.max_sample_share * static_cast<double>(mesh.vertices.size())) {
     a.failed_because = "the patch took nearly the whole frame (" + std::to_string(samples.size()) + " of " +
                        std::to_string(mesh.vertices.size()) + " vertices)";
     return a;
@@ -429,8 +473,10 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given,
   const VertexStars stars(mesh);
   std::vector<char> region = failing;
   mark_near_changes(mesh, options.changes, region);
-  region = grow_region(mesh, stars, std::move(region), options.rings);
-  for (int attempt = 0; attempt < options.attempts; ++attempt) {
+  region = grow_region(mesh, stars, std::move(region), options.policy.rings);
+  size_t fewest = SIZE_MAX;  // the fewest faults an attempt left
+  int since_fewest = 0;
+  for (int attempt = 0; attempt < options.policy.attempts; ++attempt) {
     Attempt a = try_patch(complex, mesh, stars, region, given.vertices.size(), repair, accept, options);
     if (a.ok) {
       if (!topology_as_expected(given, a.merged, options)) {
@@ -445,7 +491,17 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given,
       return out;
     }
     out.failed_because = a.failed_because;
+    // Growing the patch around its faults leaves a fraction of them when
+    // it is going to succeed, at times more for an attempt or two. Past the
+    // first kAttemptsBeforeGivingUp, two attempts in a row that left no
+    // fewer faults than the fewest before end it.
     if (a.faults.empty()) return out;
+    if (a.faults.size() < fewest) {
+      fewest = a.faults.size();
+      since_fewest = 0;
+    } else if (++since_fewest >= 2 && attempt + 1 >= kAttemptsBeforeGivingUp) {
+      return out;
+    }
     std::vector<char> more(region.size(), 0);
     for (int v : a.faults) stars.each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });
     more = grow_region(mesh, stars, std::move(more), 1);

@@ -10,6 +10,7 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/repair_policy.hpp"
 
 #include <array>
 #include <string>
@@ -42,18 +43,8 @@ struct TopologyChange {
 };
 
 struct LocalRepairOptions {
-  // Rings of triangles around the failing ones that join the patch (a
-  // count; default 1): one ring mends as many frames as two, at less cost,
-  // and none mends fewer.
-  int rings = 1;
-  int attempts = 4;            // the patch grown around the seam's faults, at most this many times
+  PatchPolicy policy;          // rings, attempts, the largest patch (repair_policy.hpp)
   double crowded_below = 0.4;  // interior vertices this close (times the target length) are removed
-  // A patch whose samples (with their context) pass this share of the
-  // frame's vertices is not tried (a share, 0-1; default 0.9): it is nearly
-  // the whole frame, which the whole-frame remesh does once, where a patch
-  // may be tried `attempts` times. Lower would also refuse patches of a
-  // third to a half of the frame, which often succeed cheaply.
-  double max_sample_share = 0.9;
   // Topology changes the patch must make (none: the topology must stay), and
   // the change of the Euler characteristic they add up to (the critical
   // events', events.hpp). The components may change by at most one a change.

@@ -187,7 +187,8 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
 long Morph::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                           std::vector<char>& drop, EditCounts& counts) {
   detail::Surgery s =
-      detail::mend_by_edits(next, std::move(moved), failing, options_.frames, {}, &frame_.ids, &refused_thinning_);
+      detail::mend_by_edits(next, std::move(moved), failing, options_.frames, options_.repair.edits, &frame_.ids,
+                            &refused_thinning_);
   std::vector<long> ids(s.origin.size());
   for (size_t v = 0; v < ids.size(); ++v)
     ids[v] = s.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(s.origin[v])] : next_id_++;
@@ -410,19 +411,21 @@ void Morph::mend_frame(const SkinComplex& next, double t, Transported& moved,
   // vanishing component or void left in the mesh; the others are
   // remeshed whole.
   detail::LocalRepairOptions local;
-  local.crowded_below = options_.crowded_below;
+  local.crowded_below = options_.repair.crowded_below;
+  local.policy = options_.repair.patch;
   const bool mendable = stats.lost == 0 && add_topology_changes(events_, sizes_, t_, t, moved.handled, local);
   long left = stats.bad_triangles;
   EditCounts edited;
-  if (mendable && left > 0 && options_.edits) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop, edited);
+  if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop, edited);
   if (mendable && local.changes.empty() && left == 0) {
     frame_.mesh = std::move(moved.mesh);
     frame_.stats.repaired = true;
   } else {
-    const bool small = left <= options_.local_repair_share * static_cast<double>(moved.failing.size());
+    const bool small = left <= options_.repair.patch.max_failing_share * static_cast<double>(moved.failing.size());
     if (!(mendable && small && repair_locally(next, moved.mesh, moved.failing, local))) {
       before_remesh();
-      frame_.stats.crowded = detail::mark_crowded(next, moved.mesh, options_.frames, options_.crowded_below, moved.drop);
+      frame_.stats.crowded =
+          detail::mark_crowded(next, moved.mesh, options_.frames, options_.repair.crowded_below, moved.drop);
       remesh_or_rebuild(next, moved.mesh, moved.drop);
     }
   }

@@ -523,7 +523,7 @@ void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, 
   FrameStats& s = frame_.stats;
   s.remeshed_because = because;
   const auto stage = Clock::now();
-  s.crowded += detail::mark_crowded(next, moved, options_.frames, options_.crowded_below, lost);
+  s.crowded += detail::mark_crowded(next, moved, options_.frames, options_.repair.crowded_below, lost);
   const bool remeshed = remesh(next, moved, lost, repair_criteria());
   if (!remeshed || mesh_topology(frame_.mesh) != topology) {
     SkinMeshResult made = mesh_skin(next, repair_criteria());
@@ -586,7 +586,8 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
   // that is not a component of its own in the step before becomes a place
   // of the local patch, whose Euler characteristic is checked.
   detail::LocalRepairOptions local;
-  local.crowded_below = options_.crowded_below;
+  local.crowded_below = options_.repair.crowded_below;
+  local.policy = options_.repair.patch;
   std::vector<detail::VanishingSphere> vanished;
   if (topology != topology_) {
     topology_changes(complex_, critical_, next, critical, false, local, vanished);
@@ -605,9 +606,10 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
   std::vector<char> failing = judge_and_relax(next, moved);
   long left = std::count(failing.begin(), failing.end(), 1);
   const auto stage = Clock::now();
-  if (left > 0 && options_.edits) {
+  if (left > 0 && options_.repair.edits.enabled) {
     detail::Surgery edited =
-        detail::mend_by_edits(next, std::move(moved), failing, options_.frames, {}, &frame_.ids, &refused_thinning_);
+        detail::mend_by_edits(next, std::move(moved), failing, options_.frames, options_.repair.edits, &frame_.ids,
+                              &refused_thinning_);
     follow(edited.origin);
     moved = std::move(edited.mesh);
     failing = std::move(edited.failing);
@@ -619,7 +621,7 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
   }
   lost.assign(moved.vertices.size(), 0);  // the edits renumbered the vertices; none is lost
   std::string because;
-  const double share = options_.local_repair_share * static_cast<double>(failing.size());
+  const double share = options_.repair.patch.max_failing_share * static_cast<double>(failing.size());
   if (left > share) {
     because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
               std::to_string(static_cast<long>(share)) + ")";

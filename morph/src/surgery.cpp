@@ -52,7 +52,7 @@ double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eig
 // triangle of a closed oriented manifold), edited in place.
 class Editor {
  public:
-  Editor(const SkinComplex& complex, SurfaceMesh mesh, const MeshingOptions& accept, const SurgeryOptions& options)
+  Editor(const SkinComplex& complex, SurfaceMesh mesh, const MeshingOptions& accept, const EditPolicy& options)
       : complex_(complex),
         mesh_(std::move(mesh)),
         accept_(accept),
@@ -122,7 +122,7 @@ class Editor {
   const SkinComplex& complex_;
   SurfaceMesh mesh_;
   const MeshingOptions& accept_;
-  SurgeryOptions options_;
+  EditPolicy options_;
   std::vector<char> alive_;
   std::vector<int> corner_face_;  // per vertex: a triangle it is a corner of (-1: gone)
   tsl::robin_map<uint64_t, int, EdgeKeyHash> edges_;
@@ -425,7 +425,7 @@ Surgery Editor::run(const std::vector<char>& failing, const std::vector<long>* i
 }  // namespace
 
 Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
-                      const MeshingOptions& accept, const SurgeryOptions& options, const std::vector<long>* ids,
+                      const MeshingOptions& accept, const EditPolicy& options, const std::vector<long>* ids,
                       RefusedEdges* refused) {
   Editor editor(complex, std::move(mesh), accept, options);
   return editor.run(failing, ids, refused);

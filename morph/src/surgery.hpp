@@ -16,36 +16,13 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/repair_policy.hpp"
 
 #include <map>
 #include <utility>
 #include <vector>
 
 namespace skinmesh::detail {
-
-struct SurgeryOptions {
-  // A failing triangle whose shortest edge is below this times the target
-  // edge length at its ends is mended by contracting that edge (transport
-  // crowds vertices where a patch shrinks) before a split is tried.
-  double contract_below = 0.5;
-  // Edits at most this many times the failing triangles (plus 64), so that
-  // edits that chase each other stop; what is left stays failing.
-  long edits_per_failing = 12;
-  // A triangle made by an edit is mended in turn, down to this many
-  // generations from a triangle that failed after transport; past it the
-  // edits are chasing each other and the triangle is left failing.
-  int generations = 3;
-  // Then every edge shorter than this times the target edge length at its
-  // ends is contracted where every triangle left passes; 0: none.
-  double thin_below = 0.5;
-  // A thinning contraction refused in an earlier frame is tried again only
-  // when its edge has shrunk by this share since, or after this many frames.
-  // Most short edges are refused frame after frame, each refusal judging a
-  // fan of triangles: they are short by design where the mesh was refined
-  // with room. A share (dimensionless) and a count of frames.
-  double retry_shrink = 0.05;
-  int retry_after_frames = 8;
-};
 
 // Thinning contractions refused, by the vertex ids of the edge's ends
 // (smaller first): the edge's length then and the frames since. Kept by the
@@ -64,10 +41,10 @@ struct Surgery {
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
 // skin of `complex`; the others are taken to pass. With `ids` (per vertex of
 // `mesh`, stable from frame to frame) and `refused`, thinning skips the
-// edges refused before (SurgeryOptions::retry_shrink) and `refused` becomes
+// edges refused before (EditPolicy::retry_shrink) and `refused` becomes
 // this frame's.
 Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
-                      const MeshingOptions& accept, const SurgeryOptions& options = {},
+                      const MeshingOptions& accept, const EditPolicy& options = {},
                       const std::vector<long>* ids = nullptr, RefusedEdges* refused = nullptr);
 
 }  // namespace skinmesh::detail

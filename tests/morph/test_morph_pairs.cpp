@@ -336,7 +336,7 @@ TEST_CASE("synthetic events: a void closes", "[morph][events]") {
 }
 
 TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: few failing triangles are repaired locally", "[morph][pairs]") {
-  // A frame with a few failing triangles (at most local_repair_share of
+  // A frame with a few failing triangles (at most PatchPolicy::max_failing_share of
   // them) and no topology event is mended in patches; the patch sees the
   // vertices of any sheet near it, not only those joined to it by the mesh,
   // so that its refinement does not mesh a sheet across a thin gap a second
@@ -347,14 +347,14 @@ TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: few failing triangles are r
   std::vector<double> times;
   for (int k = 2; k <= 18; ++k) times.push_back(k / 100.0);
   MorphOptions options;
-  options.edits = false;  // the patches themselves (edits mend most of these frames first)
+  options.repair.edits.enabled = false;  // the patches themselves (edits mend most of these frames first)
   Morph morph = prepare_morph(source, target, times.front(), options);
   long eligible = 0, local = 0;
   for (size_t k = 1; k < times.size(); ++k) {
     const FrameStats& s = morph.advance_to(times[k]).stats;
     INFO("t = " << times[k] << ": " << s.bad_triangles << " failing of " << s.triangles);
     if (s.events != 0 || s.lost != 0 || s.bad_triangles == 0) continue;
-    if (s.bad_triangles > options.local_repair_share * static_cast<double>(s.triangles)) continue;
+    if (s.bad_triangles > options.repair.patch.max_failing_share * static_cast<double>(s.triangles)) continue;
     ++eligible;
     local += s.patch_triangles > 0 && !s.remeshed;
     CHECK(!s.remeshed);
@@ -363,6 +363,42 @@ TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: few failing triangles are r
   CHECK(local == eligible);
   // And the frames themselves, every one checked as for the other pairs.
   check_frames(source, target, {0.02, 0.05, 0.08, 0.11, 0.14, 0.18}, Reference::static_mesher);
+}
+
+TEST_CASE("morph repair policy: the patch's and the edits' thresholds reach the frames", "[morph][pairs]") {
+  // The same steps as above: with the default policy some frames are
+  // mended by patches and some by edits; a patch allowed no attempt mends
+  // none (those frames are remeshed whole), and with edits off none is
+  // split, flipped or contracted.
+  const std::vector<Ball> source = molecule_balls("2k39_3models.pdb", 1);
+  const std::vector<Ball> target = molecule_balls("2k39_3models.pdb", 3);
+  struct Counts {
+    long patched = 0, remeshed = 0, edits = 0;
+  };
+  const auto run = [&](const RepairPolicy& policy) {
+    MorphOptions options;
+    options.repair = policy;
+    Morph morph = prepare_morph(source, target, 0.02, options);
+    Counts c;
+    for (int k = 3; k <= 12; ++k) {
+      const FrameStats& s = morph.advance_to(k / 100.0).stats;
+      c.patched += s.patch_triangles > 0 && !s.remeshed;
+      c.remeshed += s.remeshed;
+      c.edits += s.split + s.flipped + s.contracted;
+    }
+    return c;
+  };
+  RepairPolicy no_edits;
+  no_edits.edits.enabled = false;
+  const Counts patched = run(no_edits);
+  CHECK(patched.patched > 0);
+  CHECK(patched.edits == 0);
+  RepairPolicy no_patch = no_edits;
+  no_patch.patch.attempts = 0;
+  const Counts unpatched = run(no_patch);
+  CHECK(unpatched.patched == 0);
+  CHECK(unpatched.remeshed > patched.remeshed);
+  CHECK(run(RepairPolicy{}).edits > 0);
 }
 
 TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: failing triangles are mended by edits of the mesh", "[morph][pairs]") {

@@ -45,7 +45,7 @@ TEST_CASE("edits: thinning skips an edge refused in the frame before until it sh
   std::vector<long> ids(f.mesh.vertices.size());
   std::iota(ids.begin(), ids.end(), 100);
   const std::vector<char> none_failing(f.mesh.triangles.size(), 0);
-  const detail::SurgeryOptions options;
+  const EditPolicy options;
   auto thin = [&](detail::RefusedEdges& refused) {
     return detail::mend_by_edits(complex, f.mesh, none_failing, accept, options, &ids, &refused);
   };
@@ -91,7 +91,7 @@ TEST_CASE("local repair: a patch that would take nearly every vertex is left to 
   detail::LocalRepairOptions options;
   auto repair = [&] { return detail::repair_locally(f.complex, f.mesh, all_failing, MeshingOptions{}, f.accept, options); };
   CHECK_FALSE(repair().ok);
-  options.max_sample_share = 2;  // no bound: the same patch is meshed
+  options.policy.max_sample_share = 2;  // no bound: the same patch is meshed
   const detail::LocalRepair meshed = repair();
   CHECK(meshed.ok);
   CHECK(meshed.patch_triangles == static_cast<long>(f.mesh.triangles.size()));

@@ -13,7 +13,7 @@
 //   own;
 // - failing triangles are mended by edits of the mesh: edge splits at new
 //   skin points with Delaunay flips around them, flips, contractions of
-//   short edges (MorphOptions::edits);
+//   short edges (RepairPolicy::edits);
 // - what the edits leave, and the places where a neck opened or pinched or
 //   a component or void was born (dimension 0 or 3, seeded), grown by a
 //   ring, are remeshed by restricted Delaunay refinement of their own
@@ -38,6 +38,7 @@
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/morph/events.hpp"
 #include "skinmesh/morph/relaxation.hpp"
+#include "skinmesh/morph/repair_policy.hpp"
 
 #include <array>
 #include <functional>
@@ -62,31 +63,19 @@ struct MorphOptions {
     o.min_angle = 20.0;     // degrees
     return o;
   }();
-  // At a repair, a transported vertex nearer than this times the target
-  // edge length to a neighbour along a mesh edge is removed (transport
-  // crowds vertices where a patch shrinks; refinement puts back what the
-  // criteria need). Dimensionless; default 0.5. Lower lets the vertex count
-  // grow frame after frame; higher leaves frames coarser, not faster.
-  double crowded_below = 0.5;
   // A frame with more than this many times the triangles a fresh mesh of
   // its skin would have (the mesher's own estimate, triangle_estimate.hpp)
   // is meshed afresh, new ids and all: transport onto a shrinking skin never
-  // removes a vertex, and one pass of crowded_below removes too few.
+  // removes a vertex, and one pass of RepairPolicy::crowded_below removes
+  // too few.
   // Dimensionless; default 3. Judged only where FrameStats::density, the
   // cheap measure of every frame, passes density_screen (default 4; a mesh
   // the mesher made measures 2-3).
   double max_over_fresh = 3.0;
   double density_screen = 4.0;
-  // Local repair is tried when at most this share of the triangles fails
-  // after transport (a share, 0-1; default 0.01; 0: never); past it the
-  // patches cover much of the mesh and remeshing the whole frame from its
-  // vertices is faster.
-  double local_repair_share = 0.01;
-  // Failing triangles are first mended by edits of the mesh: an edge split
-  // at a new skin point with Delaunay flips around it, a flip, or the
-  // contraction of a short edge (docs/morph.md, "Mending by edits"); what
-  // is left goes to the local repair or the frame's remesh. false: none.
-  bool edits = true;
+  // Every threshold of the repair: crowding, the edits, the local patch
+  // (repair_policy.hpp).
+  RepairPolicy repair;
   // Repairs (local and whole-frame) may refine to stricter criteria than
   // frames are accepted at, so that a repaired triangle has room to move
   // before it fails again: the angle bound raised by the angle margin

@@ -32,6 +32,7 @@
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/relaxation.hpp"
+#include "skinmesh/morph/repair_policy.hpp"
 
 #include <functional>
 #include <map>
@@ -68,9 +69,7 @@ struct MovingOptions {
   // that moved farther (it jumped to another piece of skin) takes a new id.
   double continuity = 1.0;  // dimensionless
   RelaxationOptions relaxation;  // for the corners of failing triangles
-  bool edits = true;             // mend failing triangles by edits (split, flip, contraction)
-  double crowded_below = 0.5;    // as MorphOptions::crowded_below
-  double local_repair_share = 0.01;  // as MorphOptions::local_repair_share
+  RepairPolicy repair;           // every threshold of the repair (repair_policy.hpp)
 };
 
 class MovingBalls {

@@ -1,0 +1,74 @@
+// Every threshold of the repair a morph frame goes through, cheapest rung
+// first (docs/morph.md, "Repair"), for both engines: the m x n morph
+// (morph.hpp) and moving balls (moving_balls.hpp). Defaults are the
+// measured choices; each field says what it trades.
+#pragma once
+
+namespace skinmesh {
+
+// Edits of the mesh itself: an edge split at a new skin point with Delaunay
+// flips around it, a flip, the contraction of a short edge (docs/morph.md,
+// "Mending by edits"). Every edit keeps the mesh closed, oriented and
+// manifold and its topology; what the edits cannot mend goes on to the
+// local patch.
+struct EditPolicy {
+  bool enabled = true;  // false: no edits; failing triangles go to the patch or the remesh
+  // A failing triangle whose shortest edge is below this times the target
+  // edge length at its ends is mended by contracting that edge (transport
+  // crowds vertices where a patch shrinks) before a split is tried.
+  double contract_below = 0.5;  // dimensionless
+  // Edits at most this many times the failing triangles (plus 64), so that
+  // edits that chase each other stop; what is left stays failing.
+  long edits_per_failing = 12;
+  // A triangle made by an edit is mended in turn, down to this many
+  // generations from a triangle that failed after transport; past it the
+  // edits are chasing each other and the triangle is left failing.
+  int generations = 3;
+  // Then every edge shorter than this times the target edge length at its
+  // ends is contracted where every triangle left passes; 0: none.
+  double thin_below = 0.5;  // dimensionless
+  // A thinning contraction refused in an earlier frame is tried again only
+  // when its edge has shrunk by this share since, or after this many frames.
+  // Most short edges are refused frame after frame, each refusal judging a
+  // fan of triangles: they are short by design where the mesh was refined
+  // with room.
+  double retry_shrink = 0.05;  // a share
+  int retry_after_frames = 8;  // frames
+};
+
+// The local patch: the triangles still failing (and the places where the
+// topology changed), grown by rings, remeshed by restricted Delaunay
+// refinement of their own vertices and stitched back (docs/morph.md).
+struct PatchPolicy {
+  // A patch is tried when at most this share of the triangles fails after
+  // the edits (a share, 0-1; 0: never); past it the patches cover much of
+  // the mesh and remeshing the whole frame from its vertices is faster.
+  double max_failing_share = 0.01;
+  // Rings of triangles around the failing ones that join the patch (a
+  // count): one ring mends as many frames as two, at less cost, and none
+  // mends fewer.
+  int rings = 1;
+  // The patch grown around the seam's faults at most this many times;
+  // past the fourth, not after two attempts in a row that left no fewer
+  // faults than the fewest before.
+  int attempts = 10;
+  // A patch whose samples (with their context) pass this share of the
+  // frame's vertices is not tried (a share, 0-1): it is nearly the whole
+  // frame, which the whole-frame remesh does once, where a patch may be
+  // tried `attempts` times. Lower would also refuse patches of a third to a
+  // half of the frame, which often succeed cheaply.
+  double max_sample_share = 0.9;
+};
+
+struct RepairPolicy {
+  // At a patch or a whole-frame remesh, a transported vertex nearer than
+  // this times the target edge length to a neighbour along a mesh edge is
+  // removed (transport crowds vertices where a patch shrinks; refinement
+  // puts back what the criteria need). Dimensionless. Lower lets the vertex
+  // count grow frame after frame; higher leaves frames coarser, not faster.
+  double crowded_below = 0.5;
+  EditPolicy edits;
+  PatchPolicy patch;
+};
+
+}  // namespace skinmesh
