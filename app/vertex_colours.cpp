@@ -1,5 +1,7 @@
 #include "vertex_colours.hpp"
 
+#include "render_colours.hpp"
+
 #include "skinmesh/core/error.hpp"
 
 #include <Eigen/Geometry>
@@ -23,21 +25,11 @@ Rgb mix(const Rgb& a, const Rgb& b, double w) {
   return out;
 }
 
-// The palettes `render` draws with, so that a picture and a file agree.
-Rgb chain_colour(size_t k) {
-  static const Rgb colours[] = {rgb(0.38, 0.62, 0.85), rgb(0.95, 0.62, 0.30), rgb(0.45, 0.75, 0.45),
-                                rgb(0.85, 0.40, 0.45), rgb(0.65, 0.52, 0.80), rgb(0.70, 0.60, 0.45),
-                                rgb(0.90, 0.55, 0.75), rgb(0.60, 0.60, 0.60)};
-  return colours[k % (sizeof colours / sizeof colours[0])];
-}
-
-Rgb element_colour(const std::string& element) {
-  static const std::map<std::string, Rgb> known = {{"C", rgb(0.72, 0.72, 0.72)}, {"N", rgb(0.40, 0.52, 0.92)},
-                                                   {"O", rgb(0.92, 0.38, 0.35)}, {"S", rgb(0.95, 0.85, 0.35)},
-                                                   {"P", rgb(0.98, 0.60, 0.25)}, {"H", rgb(0.95, 0.95, 0.95)}};
-  const auto found = known.find(element);
-  return found != known.end() ? found->second : rgb(0.85, 0.55, 0.85);
-}
+// The palettes `render` draws with (render_colours.hpp), so that a picture
+// and a file agree.
+Rgb rgb(const Colour& c) { return rgb(c[0], c[1], c[2]); }
+Rgb chain_rgb(size_t k) { return rgb(palette(k)); }
+Rgb element_rgb(const std::string& element) { return rgb(element_colour(element)); }
 
 Rgb patch_colour(int dim) {
   static const Rgb by_dim[] = {rgb(0.45, 0.65, 0.90), rgb(0.98, 0.80, 0.40), rgb(0.95, 0.55, 0.35),
@@ -107,8 +99,8 @@ std::vector<Rgb> atom_colours(Colouring c, const std::vector<Atom>& atoms) {
   }
   const double last = static_cast<double>(std::max<size_t>(residues.size(), 2) - 1);
   for (const Atom& a : atoms) {
-    if (c == Colouring::chain) out.push_back(chain_colour(chains.at(a.chain)));
-    else if (c == Colouring::element) out.push_back(element_colour(a.element));
+    if (c == Colouring::chain) out.push_back(chain_rgb(chains.at(a.chain)));
+    else if (c == Colouring::element) out.push_back(element_rgb(a.element));
     else
       out.push_back(spectrum(static_cast<double>(residues.at(std::make_tuple(a.chain, a.residue_number,
                                                                              a.insertion_code, a.residue))) /
