@@ -111,13 +111,14 @@ constexpr int kAttemptsBeforeGivingUp = 4;
 // and the whole frame is remeshed. Near: within twice the longest edge of the
 // region's triangles, about the diameter of a patch facet's surface
 // Delaunay ball, and no farther than `cap` target lengths at the patch
-// vertex (infinite: no cap).
-void add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& region,
-                        const MeshingOptions& criteria, double cap, std::vector<signed char>& role) {
+// vertex (infinite: no cap). False, with `role` part-marked, as soon as the
+// patch and its context pass `most` vertices.
+bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& region,
+                        const MeshingOptions& criteria, double cap, size_t most, std::vector<signed char>& role) {
   // A region of seeds alone (a newborn component) takes the mesh's longest edge.
   double longest = longest_edge(mesh, region);
   if (!(longest > 0)) longest = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
-  if (!(longest > 0)) return;
+  if (!(longest > 0)) return true;
   const auto context = static_cast<signed char>(PatchRole::context);
   std::vector<double> reach(role.size(), 0.0);
   std::vector<double> reaches;
@@ -128,7 +129,7 @@ void add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
       reach[v] = std::min(reach[v], cap * target_edge_length(complex, mesh.vertices[v], mesh.cells[v], criteria));
     reaches.push_back(reach[v]);
   }
-  if (reaches.empty()) return;
+  if (reaches.empty()) return true;
   // Grid cells as wide as the median reach: most vertices search 27 cells.
   std::nth_element(reaches.begin(), reaches.begin() + static_cast<long>(reaches.size() / 2), reaches.end());
   const double cell = reaches[reaches.size() / 2];
@@ -139,6 +140,7 @@ void add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   std::unordered_map<int64_t, std::vector<int>> grid;  // vertices outside the patch, by grid cell
   for (int v = 0; v < static_cast<int>(mesh.vertices.size()); ++v)
     if (role[static_cast<size_t>(v)] == kNone) grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
+  size_t taken = static_cast<size_t>(std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; }));
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and the list could outgrow
   // the rest of the morph.
@@ -148,7 +150,10 @@ void add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
     const auto mark = [&](const std::vector<int>& near) {
       for (int w : near) {
         signed char& r = role[static_cast<size_t>(w)];
-        if (r == kNone && (mesh.vertices[static_cast<size_t>(w)] - p).squaredNorm() < reach[v] * reach[v]) r = context;
+        if (r == kNone && (mesh.vertices[static_cast<size_t>(w)] - p).squaredNorm() < reach[v] * reach[v]) {
+          r = context;
+          ++taken;
+        }
       }
     };
     const int span = static_cast<int>(std::ceil(reach[v] / cell));
@@ -159,7 +164,9 @@ void add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
           const auto it = grid.find(key(c + Eigen::Vector3i(i, j, k)));
           if (it != grid.end()) mark(it->second);
         }
+    if (taken > most) return false;
   }
+  return true;
 }
 
 // The context of a patch (add_nearby_context). One triangle that transport
@@ -175,11 +182,10 @@ void add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const std:
   constexpr double kLargeShare = 0.25;       // of the frame's vertices
   constexpr double kCapInTargetLengths = 6;  // dimensionless
   const std::vector<signed char> patch = role;
-  add_nearby_context(complex, mesh, region, criteria, std::numeric_limits<double>::infinity(), role);
-  const auto taken = std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; });
-  if (static_cast<double>(taken) <= kLargeShare * static_cast<double>(role.size())) return;
-  role = patch;
-  add_nearby_context(complex, mesh, region, criteria, kCapInTargetLengths, role);
+  const auto large = static_cast<size_t>(kLargeShare * static_cast<double>(role.size()));
+  if (add_nearby_context(complex, mesh, region, criteria, std::numeric_limits<double>::infinity(), large, role)) return;
+  role = patch;  // the uncapped search stopped once it passed a quarter
+  add_nearby_context(complex, mesh, region, criteria, kCapInTargetLengths, SIZE_MAX, role);
 }
 
 // Interior vertices crowded together along a patch edge: the later one goes.
