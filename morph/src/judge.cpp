@@ -1,5 +1,7 @@
 #include "judge.hpp"
 
+#include "skinmesh/core/error.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -31,6 +33,23 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
     }
   });
   return bad;
+}
+
+void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
+                   const MeshingOptions& criteria, std::vector<char>& failing) {
+  if (failing.size() != mesh.triangles.size() || moved.size() != mesh.vertices.size())
+    contract_error("rejudge_moved: verdicts or marks do not match the mesh");
+  std::vector<std::array<int, 3>> again;
+  std::vector<size_t> at;
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const std::array<int, 3>& t = mesh.triangles[f];
+    if (moved[static_cast<size_t>(t[0])] || moved[static_cast<size_t>(t[1])] || moved[static_cast<size_t>(t[2])]) {
+      again.push_back(t);
+      at.push_back(f);
+    }
+  }
+  const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
+  for (size_t k = 0; k < at.size(); ++k) failing[at[k]] = verdicts[k];
 }
 
 }  // namespace skinmesh::detail

@@ -37,4 +37,11 @@ inline bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::
 std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
                                     const std::vector<std::array<int, 3>>& triangles, const MeshingOptions& criteria);
 
+// `failing` (from failing_triangles on `mesh` before some of its vertices
+// moved) brought up to date: only the triangles with a corner marked in
+// `moved` are judged again. A verdict depends on its corners, the first
+// corner's cell and the complex alone, so the others keep theirs.
+void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
+                   const MeshingOptions& criteria, std::vector<char>& failing);
+
 }  // namespace skinmesh::detail

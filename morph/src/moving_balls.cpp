@@ -352,27 +352,42 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
-  std::vector<std::pair<int, int>> edges;
-  edges.reserve(mesh.triangles.size() * 3);
+  // Each edge once: per lower end, its higher ends sorted and made unique
+  // (buckets of a few, not one sort of every half-edge).
+  std::vector<int> first(n + 1, 0), higher(mesh.triangles.size() * 3);
   std::vector<char> used(n, 0);
   for (const auto& t : mesh.triangles)
     for (int k = 0; k < 3; ++k) {
       const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
       used[static_cast<size_t>(a)] = 1;
-      edges.emplace_back(std::min(a, b), std::max(a, b));
+      ++first[static_cast<size_t>(std::min(a, b)) + 1];
       parent[find(static_cast<size_t>(a))] = find(static_cast<size_t>(b));
     }
-  std::sort(edges.begin(), edges.end());
-  const long edge_count = std::unique(edges.begin(), edges.end()) - edges.begin();
-  std::unordered_map<size_t, double> volume;  // signed, per component root
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<int> fill(first.begin(), first.end() - 1);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
+      higher[static_cast<size_t>(fill[static_cast<size_t>(std::min(a, b))]++)] = std::max(a, b);
+    }
+  long edge_count = 0;
+  for (size_t v = 0; v < n; ++v) {
+    const auto begin = higher.begin() + first[v], end = higher.begin() + first[v + 1];
+    std::sort(begin, end);
+    edge_count += std::unique(begin, end) - begin;
+  }
+  std::vector<double> volume(n, 0.0);  // signed, per component root
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
     volume[find(static_cast<size_t>(t[0]))] +=
         a.dot(mesh.vertices[static_cast<size_t>(t[1])].cross(mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
   }
   SkinTopology out;
-  out.components = static_cast<long>(volume.size());
-  for (const auto& [root, v] : volume) out.voids += v < 0;
+  for (size_t v = 0; v < n; ++v)
+    if (used[v] && find(v) == v) {
+      ++out.components;
+      out.voids += volume[v] < 0;
+    }
   const long vertices = std::count(used.begin(), used.end(), 1);
   out.euler = vertices - edge_count + static_cast<long>(mesh.triangles.size());
   return out;
@@ -560,10 +575,20 @@ std::vector<char> MovingBalls::judge_and_relax(const SkinComplex& next, SurfaceM
   for (size_t f = 0; f < failing.size(); ++f)
     if (failing[f])
       for (int v : moved.triangles[f]) corners[static_cast<size_t>(v)] = 1;
+  std::vector<std::pair<Eigen::Vector3d, int>> before;  // each corner's place and cell
+  for (size_t v = 0; v < corners.size(); ++v)
+    if (corners[v]) before.emplace_back(moved.vertices[v], moved.cells[v]);
   relax_tangentially(next, moved, options_.relaxation, &corners);
   s.seconds_relax += seconds_since(stage);
   stage = Clock::now();
-  failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
+  // Only triangles with a corner the relaxation moved can have changed verdict.
+  size_t k = 0;
+  for (size_t v = 0; v < corners.size(); ++v)
+    if (corners[v]) {
+      corners[v] = moved.vertices[v] != before[k].first || moved.cells[v] != before[k].second;
+      ++k;
+    }
+  detail::rejudge_moved(next, moved, corners, options_.frames, failing);
   s.seconds_judge += seconds_since(stage);
   return failing;
 }

@@ -11,6 +11,7 @@
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/relaxation.hpp"
 #include "skinmesh/morph/transport.hpp"
+#include "judge.hpp"
 
 #include <tbb/task_arena.h>
 
@@ -258,4 +259,41 @@ TEST_CASE("tangential relaxation gives the same points with one thread as with s
   relax_tangentially(f.to, many, RelaxationOptions{});
   CHECK(one.vertices == many.vertices);
   CHECK(one.cells == many.cells);
+}
+
+// The moving-balls engine judges a step's triangles once, relaxes the
+// corners of those that fail, and judges again only the triangles with a
+// corner that moved. The verdicts must be those of judging every triangle.
+TEST_CASE("judging again only triangles with a moved corner gives every triangle's verdict", "[morph]") {
+  TransportedFrame f = transported_2k39_frame();
+  const MeshingOptions criteria = MorphOptions().frames;
+  std::vector<char> failing = detail::failing_triangles(f.to, f.mesh, f.mesh.triangles, criteria);
+  std::vector<char> corners(f.mesh.vertices.size(), 0);
+  for (size_t t = 0; t < failing.size(); ++t)
+    if (failing[t])
+      for (int v : f.mesh.triangles[t]) corners[static_cast<size_t>(v)] = 1;
+  const SurfaceMesh before = f.mesh;
+  relax_tangentially(f.to, f.mesh, RelaxationOptions{}, &corners);
+  std::vector<char> moved(f.mesh.vertices.size(), 0);
+  for (size_t v = 0; v < moved.size(); ++v)
+    moved[v] = f.mesh.vertices[v] != before.vertices[v] || f.mesh.cells[v] != before.cells[v];
+  const std::vector<char> judged_before = failing;
+  detail::rejudge_moved(f.to, f.mesh, moved, criteria, failing);
+  const std::vector<char> every = detail::failing_triangles(f.to, f.mesh, f.mesh.triangles, criteria);
+  CHECK(failing == every);
+  CHECK(failing != judged_before);  // the relaxation changed verdicts, so the test sees the re-judging
+  long untouched = 0;
+  for (const auto& t : f.mesh.triangles)
+    untouched += !moved[static_cast<size_t>(t[0])] && !moved[static_cast<size_t>(t[1])] && !moved[static_cast<size_t>(t[2])];
+  CHECK(untouched > static_cast<long>(f.mesh.triangles.size()) / 2);  // most were not judged again
+  // Leaving out one moved corner's triangles loses a verdict that changed.
+  std::vector<char> short_of_one = judged_before;
+  for (size_t t = 0; t < every.size(); ++t)
+    if (every[t] != judged_before[t]) {
+      std::vector<char> fewer = moved;
+      for (int v : f.mesh.triangles[t]) fewer[static_cast<size_t>(v)] = 0;
+      detail::rejudge_moved(f.to, f.mesh, fewer, criteria, short_of_one);
+      CHECK(short_of_one != every);
+      break;
+    }
 }
