@@ -64,7 +64,10 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
     const auto t0 = Clock::now();
     const bool warn = !global.quiet && !global.json;
     const std::vector<Ball> a = read_balls(o->source, o->molecule.read, o->source_model, o->molecule, o->centre, warn);
-    const std::vector<Ball> b = read_balls(o->target, o->molecule.read, o->target_model, o->molecule, o->centre, warn);
+    std::vector<Ball> b = read_balls(o->target, o->molecule.read, o->target_model, o->molecule, o->centre, warn);
+    // Balls the motion leaves nearer than kUnmovedWithin are the same ball:
+    // that near but not equal, B(t) is too nearly degenerate to mesh.
+    const long unmoved = snap_unmoved_balls(a, b);
     // All m*n pairs take 40 bytes each (the pair and its ball): refuse what
     // would not fit rather than die in the allocation.
     constexpr double kMaxAllPairs = 2e7;
@@ -83,18 +86,21 @@ void add_interpolate_command(CLI::App& app, const GlobalOptions& global, int& ex
             << a.size() << " balls) and " << o->target << " (model " << o->target_model << ", " << b.size()
             << " balls); " << (o->all ? "all pairs" : "live pairs") << (o->centre ? ", both centred" : "")
             << "; shrink " << o->molecule.shrink << ", weights "
-            << convention_name(o->molecule.convention());
+            << convention_name(o->molecule.convention()) << "; " << unmoved << " target balls within "
+            << kUnmovedWithin << " A of a source ball of the same weight put on it";
     write_file_atomically(o->output, [&](std::ostream& out) { write_wpts(out, balls, comment.str()); });
     const double seconds = seconds_since(t0);
     nlohmann::json report{{"source", o->source},  {"target", o->target},         {"t", o->t},
                           {"source_balls", a.size()}, {"target_balls", b.size()}, {"all_pairs", a.size() * b.size()},
                           {"balls", balls.size()}, {"negative_weights", negative}, {"live_pairs_only", !o->all},
+                          {"unmoved_balls", unmoved},
                           {"output", o->output},   {"seconds", seconds}};
     if (global.json) std::cout << json_text(report) << "\n";
     else if (!global.quiet)
       std::cout << o->output << ": " << balls.size() << " weighted points at t = " << o->t << " ("
                 << (o->all ? "all" : "live") << " pairs of " << a.size() << " x " << b.size() << " = "
-                << a.size() * b.size() << "; " << negative << " negative weights), " << seconds << " s\n";
+                << a.size() * b.size() << "; " << negative << " negative weights; " << unmoved
+                << " target balls unmoved), " << seconds << " s\n";
     exit_code = code(ExitCode::ok);
   });
 }

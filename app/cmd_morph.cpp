@@ -251,7 +251,9 @@ json alignment_json(const Alignment& a, long unmoved) {
           {"translation", {a.motion.translation[0], a.motion.translation[1], a.motion.translation[2]}},
           {"maps", "target coordinates into the source's frame: x' = rotation x + translation"},
           {"unmoved_atoms", unmoved},
-          {"unmoved_means", "matched target atoms within 1e-9 A of their source atom after the motion, put exactly on it"}};
+          {"unmoved_within", kUnmovedWithin},
+          {"unmoved_means", "matched target atoms within unmoved_within A of their source atom after the motion, "
+                            "put exactly on it"}};
 }
 
 // source.xyzr / target.xyzr (or .wpts when that side was read as weighted
@@ -322,16 +324,20 @@ Pairing choose_pairing(const MorphCommandOptions& o, const Sides& sides) {
   return {false, "the sides are different molecules (under 90% of the smaller side's atoms match): the m x n blend"};
 }
 
+std::string unmoved_text(long unmoved) {
+  if (unmoved == 0) return "";
+  std::ostringstream text;
+  text << "; " << unmoved << " atoms within " << kUnmovedWithin << " A of their source atom put exactly on it";
+  return text.str();
+}
+
 void print_alignment(const Sides& sides) {
   std::cerr << "skinmesh: alignment " << alignment_method_name(sides.alignment.used)
             << (sides.alignment.used == AlignmentMethod::kabsch
                     ? " on " + std::to_string(sides.alignment.matched) + " matched atoms, RMSD " +
                           std::to_string(sides.alignment.rmsd) + " A"
                     : std::string())
-            << (sides.unmoved > 0 ? "; " + std::to_string(sides.unmoved) +
-                                        " atoms within 1e-9 A of their source atom put exactly on it"
-                                  : std::string())
-            << "\n";
+            << unmoved_text(sides.unmoved) << "\n";
 }
 
 MovingOptions moving_options(const MorphOptions& m) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <deque>
 #include <set>
@@ -137,6 +138,43 @@ std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vec
     out.push_back({static_cast<int>(v->info() / n), static_cast<int>(v->info() % n)});
   std::sort(out.begin(), out.end());
   return out;
+}
+
+long snap_unmoved_balls(const std::vector<Ball>& source, std::vector<Ball>& target, double within) {
+  if (!(within > 0) || !std::isfinite(within)) contract_error("snap_unmoved_balls: `within` must be positive");
+  // Source balls by grid cell `within` wide: a target ball's partner lies in
+  // one of the 27 cells around its own.
+  using Cell = std::array<long long, 3>;
+  const auto cell_of = [&](const Eigen::Vector3d& x) {
+    return Cell{static_cast<long long>(std::floor(x[0] / within)), static_cast<long long>(std::floor(x[1] / within)),
+                static_cast<long long>(std::floor(x[2] / within))};
+  };
+  std::map<Cell, std::vector<int>> grid;
+  for (size_t k = 0; k < source.size(); ++k) grid[cell_of(source[k].center)].push_back(static_cast<int>(k));
+  long snapped = 0;
+  for (Ball& b : target) {
+    const Cell c = cell_of(b.center);
+    int nearest = -1;
+    double best = within;
+    for (long long dx = -1; dx <= 1; ++dx)
+      for (long long dy = -1; dy <= 1; ++dy)
+        for (long long dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(Cell{c[0] + dx, c[1] + dy, c[2] + dz});
+          if (it == grid.end()) continue;
+          for (int k : it->second) {
+            const Ball& a = source[static_cast<size_t>(k)];
+            const double d = (a.center - b.center).norm();
+            if (a.weight == b.weight && d <= best) {
+              best = d;
+              nearest = k;
+            }
+          }
+        }
+    if (nearest < 0) continue;
+    b.center = source[static_cast<size_t>(nearest)].center;
+    ++snapped;
+  }
+  return snapped;
 }
 
 void centre_balls(std::vector<Ball>& balls) {

@@ -179,3 +179,36 @@ TEST_CASE("hostile inputs: pept jittered by 1e-6 A keeps the jitter and meshes a
     CHECK(a["quality"]["genus"] == b["quality"]["genus"]);
   }
 }
+
+// Issue 39 #1: pept against its copy moved by 1e-9 to 3e-5 A. B(t) of all
+// pairs was then so nearly degenerate that frames failed their guarantees or
+// the refinement stalled (exit 3); atoms moved less than kUnmovedWithin now
+// count as unmoved, and their pairs leave B(t) as convex combinations.
+TEST_CASE("hostile inputs: all pairs of pept and its copy moved by 1e-9 to 3e-5 A morph and interpolate", "[cli][hostile]") {
+  const std::string pept = skinmesh::test::data_file("pept.pdb");
+  Folder out;
+  const Run reference = run_within(30, "--json mesh " + pept + " -o " + out.path + "/pept.ply");
+  REQUIRE(reference.code == 0);
+  const auto expected = nlohmann::json::parse(reference.output.substr(reference.output.find('{')))["quality"];
+  for (const char* name : {"pept-jitter-1e-9.pqr", "pept-jitter.pqr", "pept-jitter-3e-5.pqr"}) {
+    CAPTURE(name);
+    const std::string dir = out.path + "/" + name + "-morph";
+    const Run morph = run_within(30, "--quiet morph " + pept + " " + hostile(name) + " -o " + dir + " --frames 5 --pairs all");
+    INFO(morph.output);
+    REQUIRE(morph.code == 0);
+    CHECK(lines_of(dir + "/frames.jsonl") == 5);
+    std::ifstream in(dir + "/morph.json");
+    CHECK(nlohmann::json::parse(in)["alignment"]["unmoved_atoms"] == 107);
+    const std::string wpts = out.path + "/" + name + ".wpts";
+    const Run interpolate = run_within(20, "--json interpolate " + pept + " " + hostile(name) + " --t 0.5 -o " + wpts);
+    INFO(interpolate.output);
+    REQUIRE(interpolate.code == 0);
+    CHECK(nlohmann::json::parse(interpolate.output.substr(interpolate.output.find('{')))["unmoved_balls"] == 107);
+    const Run mesh = run_within(30, "--json mesh " + wpts + " -o " + wpts + ".ply");
+    INFO(mesh.output);
+    REQUIRE(mesh.code == 0);
+    const auto made = nlohmann::json::parse(mesh.output.substr(mesh.output.find('{')))["quality"];
+    CHECK(made["components"] == expected["components"]);
+    CHECK(made["genus"] == expected["genus"]);
+  }
+}

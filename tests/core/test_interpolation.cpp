@@ -197,3 +197,25 @@ TEST_CASE("a side holding the same ball twice: B(t) is that of its distinct ball
     CHECK(b[0].weight == one[0].weight);
   }
 }
+
+TEST_CASE("balls moved less than kUnmovedWithin are put on their source ball and the others stay", "[interpolation]") {
+  const std::vector<Ball> source{{Eigen::Vector3d(0, 0, 0), 4.0}, {Eigen::Vector3d(3, 0, 0), 4.0},
+                                 {Eigen::Vector3d(3, 0, 2e-4), 4.0}, {Eigen::Vector3d(0, 5, 0), 2.0}};
+  std::vector<Ball> target{{Eigen::Vector3d(1e-9, -2e-9, 0), 4.0},  // onto source 0
+                           {Eigen::Vector3d(3, 0, 1.5e-4), 4.0},    // nearer source 2 than source 1
+                           {Eigen::Vector3d(0, 5 + 3e-4, 0), 4.0},  // near source 3, another weight: stays
+                           {Eigen::Vector3d(0, 0, 6e-4), 4.0}};     // beyond kUnmovedWithin: stays
+  const std::vector<Ball> given = target;
+  CHECK(snap_unmoved_balls(source, target) == 2);
+  CHECK(target[0].center == source[0].center);
+  CHECK(target[1].center == source[2].center);
+  CHECK(target[2].center == given[2].center);
+  CHECK(target[3].center == given[3].center);
+  for (size_t k = 0; k < target.size(); ++k) CHECK(target[k].weight == given[k].weight);
+  // The pairs of two snapped balls drop out of the live pairs: with every
+  // target ball on its source ball, only the pairs (i, i) are left.
+  std::vector<Ball> copy = source;
+  for (Ball& b : copy) b.center += Eigen::Vector3d(1e-6, -1e-6, 1e-6);
+  CHECK(snap_unmoved_balls(source, copy) == static_cast<long>(source.size()));
+  CHECK(live_pairs(source, copy).size() == source.size());
+}

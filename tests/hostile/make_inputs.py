@@ -26,9 +26,10 @@ def write(name, text, bom=False):
         out.write((b"\xef\xbb\xbf" if bom else b"") + text.encode())
 
 
-def pqr(records):
+def pqr(records, decimals=7):
     return "".join(f"ATOM  {a['serial']:5d} {a['name']:<4} {a['res']} {a['chain']} {a['seq']:3d}    "
-                   f"{a['x']:.7f} {a['y']:.7f} {a['z']:.7f} 0.0000 {radius[a['element']]:.4f}\n" for a in records)
+                   f"{a['x']:.{decimals}f} {a['y']:.{decimals}f} {a['z']:.{decimals}f} 0.0000 "
+                   f"{radius[a['element']]:.4f}\n" for a in records)
 
 
 def mmcif(records):
@@ -58,6 +59,12 @@ jittered = [dict(a, x=a["x"] + random.uniform(-1e-6, 1e-6), y=a["y"] + random.un
                  z=a["z"] + random.uniform(-1e-6, 1e-6)) for a in records]
 write("pept-jitter.pqr", pqr(jittered))
 write("pept-jitter.cif", mmcif(jittered))
+# The same at 1e-9 A (twelve decimals) and at 3e-5 A, both inside the 5e-4 A
+# within which a morph or interpolate takes an atom as unmoved.
+for size, name, decimals in ((1e-9, "pept-jitter-1e-9.pqr", 12), (3e-5, "pept-jitter-3e-5.pqr", 7)):
+    random.seed(39)
+    write(name, pqr([dict(a, x=a["x"] + random.uniform(-size, size), y=a["y"] + random.uniform(-size, size),
+                          z=a["z"] + random.uniform(-size, size)) for a in records], decimals))
 # One atom, and the same atom twice.
 write("one-atom.xyzr", "0 0 0 1.7\n")
 write("one-atom-twice.xyzr", "0 0 0 1.7\n0 0 0 1.7\n")

@@ -37,6 +37,20 @@ std::vector<BallPair> all_pairs(size_t m, size_t n);
 // decides. Either way the skin of B(t) is the same.
 std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target);
 
+// How near (Angstrom) a ball of the target must be to a ball of the source,
+// of the same weight, to count as the same ball unmoved: a tenth of the
+// 1e-3 A to which PDB, PQR and mmCIF files state coordinates, so no motion a
+// structure file states is lost. Balls nearer than this but not equal make
+// B(t) nearly degenerate beyond what double precision resolves (pept
+// against its copy moved 3e-5 A fails the frames' guarantees; moved 1e-4 A
+// and farther it meshes).
+constexpr double kUnmovedWithin = 5e-4;
+
+// Every target ball within `within` of a source ball of the same weight put
+// exactly on the nearest such ball; returns how many were moved or already
+// there. Live pairs then leave out the pairs of two unmoved balls.
+long snap_unmoved_balls(const std::vector<Ball>& source, std::vector<Ball>& target, double within = kUnmovedWithin);
+
 // Moves the balls so that the mean of their centres is the origin (morphs
 // between molecules in different frames are commonly taken centred).
 void centre_balls(std::vector<Ball>& balls);

@@ -3,6 +3,7 @@
 // middle (weights fall by t(1-t)|z_i - z_j|^2, docs/math.md section 1).
 #pragma once
 
+#include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
 
 #include <Eigen/Core>
@@ -52,9 +53,9 @@ Molecule moved(Molecule molecule, const RigidMotion& motion);
 // Puts every target atom that lies within `within` (Angstrom) of its matched
 // source atom (chain, residue number, insertion code, residue and atom name)
 // exactly on it; returns how many. A fit of two identical conformations
-// leaves them about 1e-14 A apart, and balls that near make B(t) degenerate
-// by rounding alone: the pairs of two unmoved atoms are left out of a morph
-// only when the atoms are the same bit for bit (interpolation.hpp).
-long snap_unmoved(const Molecule& source, Molecule& target, double within = 1e-9);
+// leaves them about 1e-14 A apart, and balls that near make B(t) nearly
+// degenerate: the pairs of two unmoved atoms are left out of a morph only
+// when the atoms are the same bit for bit (interpolation.hpp, kUnmovedWithin).
+long snap_unmoved(const Molecule& source, Molecule& target, double within = kUnmovedWithin);
 
 }  // namespace skinmesh
