@@ -38,12 +38,13 @@ std::vector<BallPair> all_pairs(size_t m, size_t n);
 std::vector<BallPair> live_pairs(const std::vector<Ball>& source, const std::vector<Ball>& target);
 
 // How near (Angstrom) a ball of the target must be to a ball of the source,
-// of the same weight, to count as the same ball unmoved: a tenth of the
-// 1e-3 A to which PDB, PQR and mmCIF files state coordinates, so no motion a
-// structure file states is lost. Balls nearer than this but not equal make
-// B(t) nearly degenerate beyond what double precision resolves (pept
-// against its copy moved 3e-5 A fails the frames' guarantees; moved 1e-4 A
-// and farther it meshes).
+// of the same weight, to count as the same ball unmoved: half the 1e-3 A to
+// which PDB, PQR and mmCIF files state coordinates, so no motion a structure
+// file states is lost. Balls nearer than this but not equal make B(t) of all
+// pairs nearly degenerate beyond what double precision resolves (pept
+// against its copy moved 3e-5 A fails the frames' guarantees, and one copy
+// in three moved 1.5e-4 to 3e-4 A; every copy moved 4e-4 A or farther
+// meshes).
 constexpr double kUnmovedWithin = 5e-4;
 
 // Every target ball within `within` of a source ball of the same weight put
