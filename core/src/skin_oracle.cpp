@@ -128,18 +128,23 @@ using SupportMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, k
 using CentreMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxSupport>;
 using AffineMatrix = Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxSupport>;
 
-// Active-set solve restricted to `candidates`. Returns the support and weights.
-Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
-  const double s = p.s;
-  // Start at the best vertex of the simplex.
+// The candidate of least objective at a vertex of the simplex (l = e_i):
+// where the active-set solves start.
+int least_phi(const Problem& p, const std::vector<int>& candidates) {
   int start = candidates[0];
   double best = INFINITY;
   for (int i : candidates) {
     const Ball& b = p.balls[static_cast<size_t>(i)];
-    const double phi = (1 - s) * (p.x - b.center).squaredNorm() + s * b.power(p.x);
+    const double phi = (1 - p.s) * (p.x - b.center).squaredNorm() + p.s * b.power(p.x);
     if (phi < best) best = phi, start = i;
   }
-  std::vector<int> S{start};
+  return start;
+}
+
+// Active-set solve restricted to `candidates`. Returns the support and weights.
+Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
+  const double s = p.s;
+  std::vector<int> S{least_phi(p, candidates)};
   std::vector<double> l{1.0};
   // After a full step the weights sit at the minimiser on S: the next solve's
   // step is round-off, so go straight to the multipliers.
@@ -403,6 +408,212 @@ Least least_multiplier(const BallGrid& grid, const Problem& side, const Eigen::V
 
 }  // namespace
 
+namespace {
+
+// The morph's minimisation in its own unknowns (docs/math.md section 4):
+// weights l on the source's balls and u on the target's, one simplex each.
+// Near t = 0 (or 1) the pair balls b_ij(t) of one source ball i differ by
+// t |z_j - z_j'|, so the pair solve's Gram matrix is singular to round-off
+// and its answer can miss the minimum; here the target's columns enter as
+// t (z_j - x) and the step is solved in the scaled unknowns
+// (1-t) dl and t du, whose system does not depend on t.
+struct SplitSolution {
+  std::vector<int> a, b;        // supports on the source's and target's candidates
+  std::vector<double> l, u;     // their weights, each summing to 1
+};
+using SplitMatrix = Eigen::Matrix<double, 5, Eigen::Dynamic, 0, 5, kMaxSupport>;
+using SplitKkt = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxSupport + 2, kMaxSupport + 2>;
+using SplitVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSupport + 2, 1>;
+
+// x - (1-t) Z_A l - t Z_B u, summed relative to x (see Problem).
+Eigen::Vector3d split_residual(const Problem& pa, const Problem& pb, double t, const SplitSolution& w) {
+  Eigen::Vector3d y = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < w.a.size(); ++k) y += (1 - t) * w.l[k] * (pa.balls[static_cast<size_t>(w.a[k])].center - pa.x);
+  for (size_t k = 0; k < w.b.size(); ++k) y += t * w.u[k] * (pb.balls[static_cast<size_t>(w.b[k])].center - pb.x);
+  return -y;
+}
+
+
+// The most negative scaled multiplier among the candidates outside the
+// supports: (1-t)(g_i - alpha) on the source's side, t (g_j - beta) on the
+// target's (the objective's rate when weight moves onto that ball).
+struct Entering {
+  bool source_side = true;
+  int ball = -1;
+};
+Entering split_entering(const Problem& pa, const Problem& pb, double t, const SplitSolution& w,
+                        const Eigen::Vector3d& r, double alpha, double beta, const std::vector<int>& ca,
+                        const std::vector<int>& cb) {
+  Entering e;
+  double most_negative = -1e-13 * (1.0 + std::abs((1 - t) * alpha + t * beta));
+  for (int i : ca)
+    if (std::find(w.a.begin(), w.a.end(), i) == w.a.end()) {
+      const double m = (1 - t) * (pa.gradient_entry(i, r) - alpha);
+      if (m < most_negative) most_negative = m, e = {true, i};
+    }
+  for (int j : cb)
+    if (std::find(w.b.begin(), w.b.end(), j) == w.b.end()) {
+      const double m = t * (pb.gradient_entry(j, r) - beta);
+      if (m < most_negative) most_negative = m, e = {false, j};
+    }
+  return e;
+}
+
+// The equality-constrained step on the supports (ka source columns of Z
+// and g, then kb target ones), in the scaled unknowns ((1-t) dl, t du), with
+// the multipliers alpha and beta of the two simplex constraints; or, when
+// [Z; 1_A; 1_B] has dependent columns (the scale of a column does not change
+// that, so t does not enter the test), a downhill kernel direction, along
+// which the objective is linear.
+struct SplitStep {
+  SplitVector scaled;
+  double alpha = 0, beta = 0;
+  bool singular = false;
+};
+SplitStep split_step(double s, const CentreMatrix& Z, const SplitVector& g, int ka, int kb) {
+  const int k = ka + kb;
+  SplitMatrix A = SplitMatrix::Zero(5, k);
+  A.topRows(3) = Z;
+  A.row(3).head(ka).setOnes();
+  A.row(4).tail(kb).setOnes();
+  Eigen::FullPivLU<SplitMatrix> dependence(A);
+  dependence.setThreshold(1e-10);
+  SplitStep out;
+  out.singular = dependence.rank() < k;
+  if (out.singular) {
+    out.scaled = dependence.kernel().col(0);
+    if (g.dot(out.scaled) > 0) out.scaled = -out.scaled;
+    out.scaled *= 1e30;  // unbounded: the ratio test stops it
+    return out;
+  }
+  SplitKkt M = SplitKkt::Zero(k + 2, k + 2);
+  M.topLeftCorner(k, k) = 2 * (1 - s) * Z.transpose() * Z;
+  M.block(0, k, ka, 1).setConstant(-1.0);
+  M.block(ka, k + 1, kb, 1).setConstant(-1.0);
+  M.block(k, 0, 1, ka).setConstant(1.0);
+  M.block(k + 1, ka, 1, kb).setConstant(1.0);
+  SplitVector rhs = SplitVector::Zero(k + 2);
+  rhs.head(k) = -g;
+  const SplitVector sol = M.fullPivLu().solve(rhs);
+  out.scaled = sol.head(k);
+  out.alpha = sol[k], out.beta = sol[k + 1];
+  return out;
+}
+
+// Moves the weights along the step as far as they stay >= 0 (at most the
+// full step) and drops a weight that reaches 0; true after a full step.
+// Each side's step sums to 0 exactly: the round-off of the target's part,
+// divided by a small t, would otherwise move its weights' sum.
+bool take_split_step(SplitSolution& w, const SplitVector& scaled, double t) {
+  const int ka = static_cast<int>(w.a.size()), kb = static_cast<int>(w.b.size()), k = ka + kb;
+  SplitVector step(k);
+  step.head(ka) = (scaled.head(ka).array() - scaled.head(ka).mean()) / (1 - t);
+  step.tail(kb) = (scaled.tail(kb).array() - scaled.tail(kb).mean()) / t;
+  double length = 1.0;
+  int blocking = -1;
+  for (int c = 0; c < k; ++c) {
+    const double weight = c < ka ? w.l[static_cast<size_t>(c)] : w.u[static_cast<size_t>(c - ka)];
+    if (step[c] < 0 && -weight / step[c] < length) length = -weight / step[c], blocking = c;
+  }
+  for (int c = 0; c < ka; ++c) w.l[static_cast<size_t>(c)] += length * step[c];
+  for (int c = 0; c < kb; ++c) w.u[static_cast<size_t>(c)] += length * step[ka + c];
+  if (blocking >= 0) {
+    const bool on_a = blocking < ka;
+    const long at = on_a ? blocking : blocking - ka;
+    (on_a ? w.a : w.b).erase((on_a ? w.a : w.b).begin() + at);
+    (on_a ? w.l : w.u).erase((on_a ? w.l : w.u).begin() + at);
+  }
+  for (std::vector<double>* weights : {&w.l, &w.u}) {
+    const double sum = std::accumulate(weights->begin(), weights->end(), 0.0);
+    for (double& v : *weights) v = std::max(v, 0.0) / sum;
+  }
+  return blocking < 0;
+}
+
+// Primal active-set method on the two simplices (as solve_on), t in (0,1).
+SplitSolution solve_split(const Problem& pa, const Problem& pb, double t, const std::vector<int>& ca,
+                          const std::vector<int>& cb) {
+  SplitSolution w{{least_phi(pa, ca)}, {least_phi(pb, cb)}, {1.0}, {1.0}};
+  bool at_subproblem_minimum = true;
+  for (int iteration = 0; iteration < 400; ++iteration) {
+    const int ka = static_cast<int>(w.a.size()), kb = static_cast<int>(w.b.size()), k = ka + kb;
+    const Eigen::Vector3d r = split_residual(pa, pb, t, w);
+    SplitVector g(k);
+    CentreMatrix Z(3, k);
+    for (int c = 0; c < k; ++c) {
+      const Problem& p = c < ka ? pa : pb;
+      const int ball = c < ka ? w.a[static_cast<size_t>(c)] : w.b[static_cast<size_t>(c - ka)];
+      g[c] = p.gradient_entry(ball, r);
+      Z.col(c) = p.balls[static_cast<size_t>(ball)].center - p.x;
+    }
+    const SplitStep step = split_step(pa.s, Z, g, ka, kb);
+    if (!step.singular && (at_subproblem_minimum || step.scaled.cwiseAbs().maxCoeff() <= 1e-15)) {
+      at_subproblem_minimum = false;
+      const Entering e = split_entering(pa, pb, t, w, r, step.alpha, step.beta, ca, cb);
+      if (e.ball < 0 || k == kMaxSupport) return w;
+      (e.source_side ? w.a : w.b).push_back(e.ball);
+      (e.source_side ? w.l : w.u).push_back(0.0);
+      continue;
+    }
+    at_subproblem_minimum = take_split_step(w, step.scaled, t);
+  }
+  return w;
+}
+
+}  // namespace
+
+namespace {
+
+// The morph oracle's answer from the split solve, judged exactly as the pair
+// solve's: its supports become the pairs (i, j) of weight l_i u_j (the same
+// point and value), certified against every pair by each side's least
+// multiplier. Candidates on each side grow by the balls that violate.
+MorphOracleResult split_evaluate(const BallGrid& grid_a, const BallGrid& grid_b, const Problem& pa,
+                                 const Problem& pb, double t) {
+  std::vector<int> ca = least_power(grid_a, pa.balls, pa.x, 8), cb = least_power(grid_b, pb.balls, pb.x, 8);
+  MorphOracleResult out;
+  for (int round = 0; round < 50; ++round) {
+    const SplitSolution w = solve_split(pa, pb, t, ca, cb);
+    std::vector<BallPair> pairs;
+    Solution sol;
+    for (size_t i = 0; i < w.a.size(); ++i)
+      for (size_t j = 0; j < w.b.size(); ++j)
+        if (w.l[i] * w.u[j] > 0) {
+          sol.support.push_back(static_cast<int>(pairs.size()));
+          sol.lambda.push_back(w.l[i] * w.u[j]);
+          pairs.push_back({w.a[i], w.b[j]});
+        }
+    const std::vector<Ball> balls = interpolated_balls(pa.balls, pb.balls, pairs, t);
+    const Problem p{balls, pa.s, pa.x};
+    const Stationary st = stationary(p, sol);
+    take_solution(out, st, sol, [&](int candidate) { return pairs[static_cast<size_t>(candidate)]; });
+    const Least a = least_multiplier(grid_a, pa, st.r), b = least_multiplier(grid_b, pb, st.r);
+    out.kkt_violation = std::max(st.violation, (st.mu - ((1 - t) * a.g + t * b.g)) / st.scale);
+    out.certified = out.kkt_violation < 1e-9;
+    // Balls whose side multiplier lies below that side's mean on its support
+    // by more than the pair test allows join the candidates.
+    double alpha = 0, beta = 0;
+    for (size_t i = 0; i < w.a.size(); ++i) alpha += w.l[i] * pa.gradient_entry(w.a[i], st.r);
+    for (size_t j = 0; j < w.b.size(); ++j) beta += w.u[j] * pb.gradient_entry(w.b[j], st.r);
+    const auto violators = [&](const BallGrid& grid, const Problem& side, double below, std::vector<int>& candidates) {
+      std::vector<int> found;
+      visit_near(grid, side.balls, side.x, certification_radius(side.s, st.r, below, grid.max_weight()), [&](int k) {
+        if (side.gradient_entry(k, st.r) < below && std::find(candidates.begin(), candidates.end(), k) == candidates.end())
+          found.push_back(k);
+      });
+      candidates.insert(candidates.end(), found.begin(), found.end());
+      return !found.empty();
+    };
+    const bool more_a = violators(grid_a, pa, alpha - 1e-12 * st.scale / (1 - t), ca);
+    const bool more_b = violators(grid_b, pb, beta - 1e-12 * st.scale / t, cb);
+    if (!more_a && !more_b) break;
+  }
+  return out;
+}
+
+}  // namespace
+
+
 MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t) const {
   if (!(t >= 0 && t <= 1)) contract_error("MorphOracle: t must lie in [0, 1]");
   if (t == 0) return end_result(source_.evaluate(x), true);
@@ -446,6 +657,10 @@ MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t) cons
                [&](int j) { add({a.ball, j}); });
     if (violators.empty()) break;
     pairs.insert(pairs.end(), violators.begin(), violators.end());
+  }
+  if (!out.certified) {  // near t = 0 or 1 the pair solve can miss the minimum: solve in the split unknowns
+    MorphOracleResult split = split_evaluate(*source_.grid_, *target_.grid_, side_a, side_b, t);
+    if (split.kkt_violation < out.kkt_violation) out = std::move(split);
   }
   return out;
 }

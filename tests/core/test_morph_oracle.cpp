@@ -88,3 +88,62 @@ TEST_CASE("morph oracle: the complex of the live pairs of B(t) has the frame's s
     }
   }
 }
+
+namespace {
+
+// Points on the skin of `balls`, by bisection of the skin oracle's sign along
+// rays out of each ball's centre (a centre inside the skin to a point 4 A
+// beyond its sphere, outside when the ray leaves the molecule).
+std::vector<Eigen::Vector3d> points_on_skin(const std::vector<Ball>& balls, int rays_per_ball, unsigned seed) {
+  const SkinOracle oracle(balls, 0.5);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0, 1);
+  std::vector<Eigen::Vector3d> points;
+  for (const Ball& b : balls)
+    for (int k = 0; k < rays_per_ball; ++k) {
+      const Eigen::Vector3d d = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+      Eigen::Vector3d inside = b.center, outside = b.center + (std::sqrt(std::max(b.weight, 0.0)) + 4) * d;
+      if (!(oracle.evaluate(inside).value < 0) || !(oracle.evaluate(outside).value > 0)) continue;
+      for (int step = 0; step < 60; ++step) {
+        const Eigen::Vector3d mid = 0.5 * (inside + outside);
+        (oracle.evaluate(mid).value < 0 ? inside : outside) = mid;
+      }
+      points.push_back(0.5 * (inside + outside));
+    }
+  return points;
+}
+
+}  // namespace
+
+// Issue 39 #1: within about 1e-5 of t = 0 the pair balls b_ij(t) of one source
+// ball differ by t |z_j - z_j'|, and the solve over pairs missed the minimum
+// on 1-2% of the skin's points (KKT gap past 1e-9: uncertified). Every point
+// must be certified there, agree with the skin oracle of B(t)'s live pairs
+// where that one certifies, and move continuously from the end's own skin.
+TEST_CASE("morph oracle: points next to t = 0 and 1, where pair balls nearly coincide, are certified", "[oracle][morph]") {
+  const auto pept = test::centred_model(test::data_file("pept.pdb"), 1);
+  const auto al1 = test::centred_model(test::data_file("3al1.pdb"), 1);
+  const MorphOracle morph(pept, al1, 0.5);
+  const std::vector<BallPair> live = live_pairs(pept, al1);
+  const std::vector<Eigen::Vector3d> on_source = points_on_skin(pept, 12, 5), on_target = points_on_skin(al1, 4, 6);
+  REQUIRE(on_source.size() > 500);
+  REQUIRE(on_target.size() > 500);
+  for (double t : {1e-6, 3e-6, 1 - 1e-6, 1 - 3e-6}) {
+    INFO("t = " << t);
+    const bool near_source = t < 0.5;
+    const SkinOracle end(near_source ? pept : al1, 0.5);
+    const SkinOracle frame(interpolated_balls(pept, al1, live, t), 0.5);
+    long uncertified = 0, compared = 0;
+    for (const Eigen::Vector3d& x : near_source ? on_source : on_target) {
+      const MorphOracleResult m = morph.evaluate(x, t);
+      uncertified += !m.certified;
+      CHECK(std::abs(m.value - end.evaluate(x).value) <= 1e-2 * std::min(t, 1 - t) / 1e-6);
+      const OracleResult o = frame.evaluate(x);
+      if (!o.certified) continue;
+      ++compared;
+      CHECK(std::abs(m.value - o.value) <= 1e-9 * std::max(1.0, std::abs(o.value)));
+    }
+    CHECK(uncertified == 0);
+    CHECK(compared > 0);
+  }
+}
