@@ -115,6 +115,27 @@ std::vector<double> frame_times(const MorphCommandOptions& o) {
   return t;
 }
 
+// The m x n blend's frames other than its ends keep this far from t = 0 and
+// 1. Closer, the pair balls b_ij(t) of one ball lie within t |z_j - z_j'| of
+// each other and the overlay complex of B(t) is degenerate to round-off:
+// point location in it falls back to searching every cell, and a frame at
+// 1e-6 took 10-20 times one at 1e-5, one at 1e-7 ran for minutes
+// (docs/morph.md, limits).
+constexpr double kBlendEndMargin = 1e-5;
+
+void check_blend_times(const std::vector<double>& times) {
+  for (double t : times) {
+    if (!(t > 0 && t < 1 && std::min(t, 1 - t) < kBlendEndMargin * (1 - 1e-9))) continue;
+    char text[32];
+    std::snprintf(text, sizeof text, "%.10g", t);
+    contract_error(std::string("frame time ") + text + " lies within 1e-05 of t = " + (t < 0.5 ? "0" : "1") +
+                   ": there the m x n blend's balls of one atom differ by round-off and its complex cannot be "
+                   "meshed in bounded time; use t = " + (t < 0.5 ? "0" : "1") +
+                   " itself or a time at least 1e-05 from it; --pairs matched has no "
+                   "such limit");
+  }
+}
+
 // The morph's frame criteria follow from the command's options: the first
 // frame at the mesher's 30 degrees (room for transport), later frames at
 // --min-angle, both with the sizing asked for.
@@ -475,6 +496,7 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
     std::cerr << "skinmesh: pairs " << (pairing.matched ? "matched" : "all") << ": " << pairing.why << "\n";
   }
   if (pairing.matched) return run_matched_morph(o, global, sides, times, pairing, start);
+  check_blend_times(times);
   FrameFiles files(o.files, sides.source, sides.target);
   OutputDirectory dir(o.directory);
   OutputSet outputs;
