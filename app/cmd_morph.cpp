@@ -199,10 +199,8 @@ struct FrameReference {
 };
 
 // Each vertex's distance to the skin of B(t) by the morph oracle, which
-// knows neither the morph's complex nor its live pairs. Very near an end
-// the oracle may not certify a point (a KKT gap left, where B(t)'s own
-// complex and the overlay complex put the point on the skin; docs/morph.md,
-// "What is not there yet"): those vertices are measured instead on
+// knows neither the morph's complex nor its live pairs. A point the oracle
+// cannot certify (a KKT gap left by both its solves) is measured instead on
 // the complex of B(t)'s balls built from scratch (a regular triangulation,
 // not the morph's overlay), and counted in `uncertified`.
 double largest_error(const SurfaceMesh& mesh, const FrameReference& reference, double t, long& uncertified) {
