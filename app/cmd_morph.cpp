@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -186,7 +187,7 @@ Sides read_sides(const MorphCommandOptions& o) {
 // certify, the complex of B(t)'s balls built from scratch.
 struct FrameReference {
   const MorphOracle& oracle;
-  const Morph& morph;
+  const std::vector<BallPair>& pairs;  // the morph's live pairs, fixed for its whole run
   const std::vector<Ball>& source;
   const std::vector<Ball>& target;
   double shrink;
@@ -194,7 +195,7 @@ struct FrameReference {
   std::vector<Ball> balls_at(double t) const {
     if (t == 0.0) return source;
     if (t == 1.0) return target;
-    return interpolated_balls(source, target, morph.pairs(), t);
+    return interpolated_balls(source, target, pairs, t);
   }
 };
 
@@ -245,18 +246,34 @@ json blend_frame_json(const FrameStats& s, const FrameCheck& c, const std::strin
   return j;
 }
 
+// A frame of the blend copied out of the morph, with what writing it needs,
+// so that it is checked and written while the next frame is made.
+struct BlendFrame {
+  size_t index = 0;
+  double t = 0;
+  MorphFrame frame;
+  std::vector<int> patch;                 // per vertex: the dimension of its cell's Delaunay simplex
+  std::vector<std::array<int, 2>> sides;  // per vertex: its source and target atoms (-1: none)
+};
+
+BlendFrame snapshot_blend(const Morph& morph, size_t k, double t) {
+  BlendFrame b;
+  b.index = k;
+  b.t = t;
+  b.frame = morph.frame();
+  for (int cell : b.frame.mesh.cells) b.patch.push_back(morph.complex().cell(cell).dim);
+  b.sides = morph.vertex_atoms();
+  return b;
+}
+
 // The frame as `files` says, with per-vertex patch, id and the source and
 // target atoms ("atom" and atomid: the source atom where there is one, the
 // target atom otherwise).
-void stage_frame(OutputSet& outputs, const OutputDirectory& dir, size_t k, const Morph& morph, FrameFiles& files) {
-  const MorphFrame& f = morph.frame();
-  std::vector<int> patch;
-  for (int cell : f.mesh.cells) patch.push_back(morph.complex().cell(cell).dim);
-  const std::vector<std::array<int, 2>> sides = morph.vertex_atoms();
+void stage_frame(OutputSet& outputs, const OutputDirectory& dir, const BlendFrame& b, FrameFiles& files) {
   std::vector<int> atom;
-  for (const auto& [s, t] : sides) atom.push_back(s >= 0 ? s : t);
-  VertexAttributes a = frame_attributes(std::move(patch), std::move(atom), f.ids, sides);
-  stage_frame_files(outputs, dir, k, f.mesh, a, sides, files);
+  for (const auto& [s, t] : b.sides) atom.push_back(s >= 0 ? s : t);
+  VertexAttributes a = frame_attributes(b.patch, std::move(atom), b.frame.ids, b.sides);
+  stage_frame_files(outputs, dir, b.index, b.frame.mesh, a, b.sides, files);
 }
 
 json alignment_json(const Alignment& a, long unmoved) {
@@ -467,6 +484,52 @@ std::vector<double> change_spaced(size_t frames, const std::function<std::vector
   return t;
 }
 
+// Where the blend's frames go, and what is said of them.
+struct BlendOutputs {
+  FrameFiles& files;
+  OutputSet& outputs;
+  const OutputDirectory& dir;
+  ProgressLine& shown;
+  std::ostream& lines;  // frames.jsonl
+  FrameCounts& counts;
+};
+
+// Every frame of the blend made, checked and staged; frame k is checked and
+// staged while frame k+1 is made (the morph's repairs are mostly serial).
+// False, with the failing frame reported, when a frame fails a guarantee.
+bool make_blend_frames(Morph& morph, const std::vector<double>& times, const FrameReference& reference,
+                       double min_angle, bool self_intersections, const BlendOutputs& out) {
+  PaceEstimate pace(times.size());
+  BlendFrame pending;
+  FrameCheck check;
+  tbb::task_group checking;  // after what its task reads: if advance_to throws, it waits before they go
+  const auto finish = [&]() {
+    checking.wait();
+    const json line = blend_frame_json(pending.frame.stats, check, out.files.listed_file(pending.index));
+    if (!check.holds) {
+      out.shown.finish();
+      std::cerr << "skinmesh: error: frame " << pending.index << " (t = " << pending.t
+                << ") fails a guarantee; nothing written\n"
+                << json_text(line) << "\n";
+      return false;
+    }
+    stage_frame(out.outputs, out.dir, pending, out.files);
+    out.lines << json_text(line, JsonLayout::one_line) << "\n";
+    out.counts.add(line);
+    pace.done_one();
+    print_progress(out.shown, pace, times.size(), pending.frame.stats, out.counts.repairs);
+    return true;
+  };
+  for (size_t k = 0; k < times.size(); ++k) {
+    if (k > 0) morph.advance_to(times[k], k + 1 < times.size() ? times[k + 1] : -1);
+    BlendFrame made = snapshot_blend(morph, k, times[k]);
+    if (k > 0 && !finish()) return false;
+    pending = std::move(made);
+    checking.run([&] { check = check_frame(pending.frame.mesh, reference, pending.t, min_angle, self_intersections); });
+  }
+  return finish();
+}
+
 ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& global) {
   check_formats(o.files.formats);
   const bool progress = !global.quiet && !global.json;
@@ -505,27 +568,12 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
   const MorphOracle oracle(sides.source_balls, sides.target_balls, o.molecule.shrink);
   Morph morph = prepare_morph(sides.source_balls, sides.target_balls, times.front(), prepared);
   shown->finish();
-  PaceEstimate pace(times.size());
-  const FrameReference reference{oracle, morph, sides.source_balls, sides.target_balls, o.molecule.shrink};
+  const FrameReference reference{oracle, morph.pairs(), sides.source_balls, sides.target_balls, o.molecule.shrink};
   std::ostringstream lines;
   FrameCounts counts;
-  for (size_t k = 0; k < times.size(); ++k) {
-    const MorphFrame& f =
-        k == 0 ? morph.frame() : morph.advance_to(times[k], k + 1 < times.size() ? times[k + 1] : -1);
-    const FrameCheck check = check_frame(f.mesh, reference, times[k], options.frames.min_angle, !o.no_self_intersections);
-    json line = blend_frame_json(f.stats, check, files.listed_file(k));
-    if (!check.holds) {
-      shown->finish();
-      std::cerr << "skinmesh: error: frame " << k << " (t = " << times[k] << ") fails a guarantee; nothing written\n"
-                << json_text(line) << "\n";
-      return ExitCode::not_met;
-    }
-    stage_frame(outputs, dir, k, morph, files);
-    lines << json_text(line, JsonLayout::one_line) << "\n";
-    counts.add(line);
-    pace.done_one();
-    print_progress(*shown, pace, times.size(), f.stats, counts.repairs);
-  }
+  const BlendOutputs out{files, outputs, dir, *shown, lines, counts};
+  if (!make_blend_frames(morph, times, reference, options.frames.min_angle, !o.no_self_intersections, out))
+    return ExitCode::not_met;
   shown->finish();
   json report = morph_json(o, sides, morph, times, options);
   report["skinmesh_version"] = version_text();
