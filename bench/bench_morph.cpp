@@ -6,7 +6,10 @@
 //   (b) each frame rebuilt by skinmesh's quality mesher from the live pairs
 //       (complex and mesh, at the morph's frame criteria);
 //   (c) the morph: the source side meshed once at the first frame, then every
-//       later frame transported and repaired (morph/morph.hpp).
+//       later frame transported and repaired (morph/morph.hpp);
+//   (c_cmd) the `skinmesh morph --pairs all` command at the same times: the
+//       morph with the command's check of every frame and its output (its
+//       quality columns are what the command's frames.jsonl says).
 // (c) runs every frame; (a) and (b) cost the same at every frame and average
 // a sample spread over (0,1). Quality per column is measured with the clock
 // stopped: every frame graded (closed, manifold, oriented, self-intersections,
@@ -28,8 +31,12 @@
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -104,6 +111,41 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
     c.relocated += static_cast<double>(f.stats.relocated);
     c.grade(f.mesh, oracle, ts[k]);
   }
+  return c;
+}
+
+// (c_cmd): the command's wall time over its frames, into a temporary folder
+// removed after; every frame's quality as its frames.jsonl reports it.
+Column run_command(const Pair& p, int frames) {
+  std::string times;
+  for (double t : frame_times(frames)) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%s%.17g", times.empty() ? "" : ",", t);
+    times += text;
+  }
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("bench_morph_" + std::to_string(getpid()));
+  const std::string command = std::string("'") + SKINMESH_BINARY + "' --quiet morph " + p.command_sides +
+                              " --pairs all --t " + times + " -o '" + dir.string() + "'";
+  const auto start = Clock::now();
+  const int status = std::system(command.c_str());
+  Column c;
+  c.seconds = seconds_since(start);
+  std::ifstream jsonl(dir / "frames.jsonl");
+  for (std::string line; std::getline(jsonl, line);) {
+    const nlohmann::json f = nlohmann::json::parse(line);
+    c.frames += 1;
+    c.triangles += f["triangles"].get<double>();
+    c.vertices += f["vertices"].get<double>();
+    c.min_angle = std::min(c.min_angle, f["min_angle"].get<double>());
+    c.below_20 += f["share_below_bound"].get<double>() * f["triangles"].get<double>();
+    c.max_error = std::max(c.max_error, f["max_onsurf_error"].get<double>());
+    c.uncertified += f["oracle_uncertified"].get<double>();
+    c.repaired += f["repaired"].get<bool>();
+    c.full_rebuilds += f["full_rebuild"].get<bool>();
+  }
+  c.remeshed = NAN;  // frames.jsonl of the blend does not say which repairs remeshed the whole frame
+  std::filesystem::remove_all(dir);
+  if (status != 0 || c.frames != frames) throw std::runtime_error("the command failed: " + command.substr(0, 200));
   return c;
 }
 
@@ -218,17 +260,19 @@ void print_table(const std::vector<Row>& rows, int timeout) {
                 c.min_angle, 100 * c.below_20 / std::max(1.0, c.triangles), c.max_error, c.invalid_frames,
                 c.repaired, c.remeshed, c.full_rebuilds);
   }
-  std::printf("\n| pair | a/c | b/c |\n|---|---|---|\n");
+  std::printf("\n| pair | a/c | b/c | b/c_cmd |\n|---|---|---|---|\n");
   for (size_t i = 0; i < rows.size(); ++i) {
     if (rows[i].column != "c morph") continue;
-    const Row *a = nullptr, *b = nullptr;
+    const Row *a = nullptr, *b = nullptr, *cmd = nullptr;
     for (const Row& r : rows)
       if (r.pair == rows[i].pair) {
         if (r.column.rfind("a ", 0) == 0) a = &r;
         if (r.column.rfind("b ", 0) == 0) b = &r;
+        if (r.column.rfind("c_cmd ", 0) == 0) cmd = &r;
       }
     const double c = per_frame(&rows[i]);
-    std::printf("| %s | %.1f | %.1f |\n", rows[i].pair.c_str(), per_frame(a) / c, per_frame(b) / c);
+    std::printf("| %s | %.1f | %.1f | %.1f |\n", rows[i].pair.c_str(), per_frame(a) / c, per_frame(b) / c,
+                per_frame(b) / per_frame(cmd));
   }
   print_stage_table(rows);
 }
@@ -271,6 +315,7 @@ int main(int argc, char** argv) {
     columns.emplace_back("b skinmesh rebuild, live pairs", [&] { return run_rebuilds(p, sample); });
     columns.emplace_back("c morph", [&] { return run_morph(p, frames, true); });
     columns.emplace_back("c' morph, whole-frame repairs only", [&] { return run_morph(p, frames, false); });
+    columns.emplace_back("c_cmd skinmesh morph --pairs all", [&] { return run_command(p, frames); });
     for (const auto& [name, task] : columns) {
       if (!only.empty() && name.find(only) == std::string::npos) continue;
       std::fprintf(stderr, "%s: %s ...\n", p.name.c_str(), name.c_str());

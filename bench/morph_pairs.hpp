@@ -19,16 +19,25 @@ struct Pair {
   std::string name;
   std::vector<Ball> source, target;
   std::string alignment;
+  std::string command_sides;  // the same sides as `skinmesh morph` arguments: files and model options
 };
 
+// "FILE#MODEL" as the file and the model (0: the reader's default).
+struct Side {
+  std::string file;
+  int model = 0;
+};
+inline Side split_side(const std::string& spec) {
+  const auto hash = spec.find('#');
+  if (hash == std::string::npos) return {spec, 0};
+  return {spec.substr(0, hash), std::atoi(spec.c_str() + hash + 1)};
+}
+
 inline Molecule read_side(const std::string& spec) {
+  const Side side = split_side(spec);
   ReadOptions read;
-  std::string path = spec;
-  if (const auto hash = spec.find('#'); hash != std::string::npos) {
-    path = spec.substr(0, hash);
-    read.model = std::atoi(spec.c_str() + hash + 1);
-  }
-  return read_molecule(path, read);
+  if (side.model > 0) read.model = side.model;
+  return read_molecule(side.file, read);
 }
 
 inline Pair load_pair(const std::string& spec, double shrink) {
@@ -49,6 +58,10 @@ inline Pair load_pair(const std::string& spec, double shrink) {
   p.source = balls_from_molecule(source, shrink);
   p.target = balls_from_molecule(target, shrink);
   p.alignment = alignment_method_name(a.used);
+  const Side s = split_side(source_spec), t = split_side(target_spec);
+  p.command_sides = "'" + s.file + "' '" + t.file + "'";
+  if (s.model > 0) p.command_sides += " --source-model " + std::to_string(s.model);
+  if (t.model > 0) p.command_sides += " --target-model " + std::to_string(t.model);
   return p;
 }
 
