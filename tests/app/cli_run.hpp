@@ -2,11 +2,14 @@
 #pragma once
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 
 namespace skinmesh::test {
 
@@ -14,6 +17,14 @@ struct Run {
   int code;
   std::string output;  // stdout and stderr together
 };
+
+// The lines of a morph directory's frames.jsonl, one a frame.
+inline std::vector<nlohmann::json> frame_lines(const std::string& dir) {
+  std::ifstream in(dir + "/frames.jsonl");
+  std::vector<nlohmann::json> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+  return lines;
+}
 
 // Runs a shell command line, stdout and stderr together.
 inline Run run_shell(const std::string& command) {
