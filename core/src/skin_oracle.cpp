@@ -336,7 +336,7 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
     return none;
   }
   const Problem p{balls_, shrink_, x};
-  std::vector<int> candidates = least_power(*grid_, balls_, x, 24);
+  std::vector<int> candidates = least_power(*grid_, balls_, x, 12);
   OracleResult out;
   for (int round = 0; round < 50; ++round) {
     const Solution sol = solve_on(p, candidates);
@@ -622,10 +622,11 @@ MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t) cons
   const std::vector<Ball>& A = source_.balls();
   const std::vector<Ball>& B = target_.balls();
   const Problem side_a{A, s, x}, side_b{B, s, x};
-  // Candidates: every pair of a few balls of least power on each side.
+  // Candidates: every pair of a few balls of least power on each side (four:
+  // the pairs grow as the square, and fewer cost more rounds).
   std::vector<BallPair> pairs;
-  for (int i : least_power(*source_.grid_, A, x, 6))
-    for (int j : least_power(*target_.grid_, B, x, 6)) pairs.push_back({i, j});
+  for (int i : least_power(*source_.grid_, A, x, 4))
+    for (int j : least_power(*target_.grid_, B, x, 4)) pairs.push_back({i, j});
   MorphOracleResult out;
   for (int round = 0; round < 50; ++round) {
     const std::vector<Ball> balls = interpolated_balls(A, B, pairs, t);
