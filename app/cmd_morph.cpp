@@ -120,7 +120,7 @@ std::vector<double> frame_times(const MorphCommandOptions& o) {
 // 1. Closer, the pair balls b_ij(t) of one ball lie within t |z_j - z_j'| of
 // each other and the overlay complex of B(t) is degenerate to round-off:
 // point location in it falls back to searching every cell, and a frame at
-// 1e-6 took 10-20 times one at 1e-5, one at 1e-7 ran for minutes
+// 1e-6 took 3 to 22 times one at 1e-5, one at 1e-7 ran for minutes
 // (docs/morph.md, limits).
 constexpr double kBlendEndMargin = 1e-5;
 
