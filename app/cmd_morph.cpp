@@ -127,13 +127,14 @@ constexpr double kBlendEndMargin = 1e-5;
 void check_blend_times(const std::vector<double>& times) {
   for (double t : times) {
     if (!(t > 0 && t < 1 && std::min(t, 1 - t) < kBlendEndMargin * (1 - 1e-9))) continue;
-    char text[32];
+    char text[32], margin[16];
     std::snprintf(text, sizeof text, "%.10g", t);
-    contract_error(std::string("frame time ") + text + " lies within 1e-05 of t = " + (t < 0.5 ? "0" : "1") +
+    std::snprintf(margin, sizeof margin, "%g", kBlendEndMargin);
+    const std::string end = t < 0.5 ? "0" : "1";
+    contract_error(std::string("frame time ") + text + " lies within " + margin + " of t = " + end +
                    ": there the m x n blend's balls of one atom differ by round-off and its complex cannot be "
-                   "meshed in bounded time; use t = " + (t < 0.5 ? "0" : "1") +
-                   " itself or a time at least 1e-05 from it; --pairs matched has no "
-                   "such limit");
+                   "meshed in bounded time; use t = " + end + " itself or a time at least " + margin +
+                   " from it; --pairs matched has no such limit");
   }
 }
 

@@ -406,9 +406,6 @@ Least least_multiplier(const BallGrid& grid, const Problem& side, const Eigen::V
   return least;
 }
 
-}  // namespace
-
-namespace {
 
 // The morph's minimisation in its own unknowns (docs/math.md section 4):
 // weights l on the source's balls and u on the target's, one simplex each.
@@ -559,10 +556,6 @@ SplitSolution solve_split(const Problem& pa, const Problem& pb, double t, const 
   }
   return w;
 }
-
-}  // namespace
-
-namespace {
 
 // The morph oracle's answer from the split solve, judged exactly as the pair
 // solve's: its supports become the pairs (i, j) of weight l_i u_j (the same
