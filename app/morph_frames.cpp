@@ -216,6 +216,8 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"thinned", s.thinned},
           {"repaired", s.repaired},
           {"full_rebuild", s.full_rebuild},
+          {"remeshed", s.remeshed},
+          {"remeshed_because", s.remeshed ? json(s.remeshed_because) : json(nullptr)},
           {"max_onsurf_error", c.max_error},
           {"oracle_uncertified", c.uncertified},
           {"components", q.components},
@@ -299,8 +301,6 @@ json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::stri
   j["reidentified"] = s.reidentified;
   j["ids_kept"] = s.ids_kept;
   j["max_kept_move"] = s.max_kept_move;
-  j["remeshed"] = s.remeshed;
-  j["remeshed_because"] = s.remeshed ? json(s.remeshed_because) : json(nullptr);
   return j;
 }
 

@@ -169,7 +169,10 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
                            const detail::LocalRepairOptions& local) {
   detail::LocalRepair r =
       detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
-  if (!r.ok) return false;
+  if (!r.ok) {
+    frame_.stats.remeshed_because = "the local patch failed: " + r.failed_because;
+    return false;
+  }
   std::vector<long> ids(r.origin.size());  // inserted and removed are counted by ids (advance_to)
   for (size_t v = 0; v < ids.size(); ++v)
     ids[v] = r.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(r.origin[v])] : next_id_++;
@@ -244,6 +247,7 @@ void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
     return;
   }
   const auto repair_start = Clock::now();
+  frame_.stats.remeshed_because = "the frame moves between one side's own complex (t = 0 or 1) and the overlay's";
   remesh_or_rebuild(next, moved, lost);
   frame_.stats.seconds_repair = seconds_since(repair_start);
 }
@@ -421,7 +425,15 @@ void Morph::mend_frame(const SkinComplex& next, double t, Transported& moved,
     frame_.mesh = std::move(moved.mesh);
     frame_.stats.repaired = true;
   } else {
-    const bool small = left <= options_.repair.patch.max_failing_share * static_cast<double>(moved.failing.size());
+    const double share = options_.repair.patch.max_failing_share * static_cast<double>(moved.failing.size());
+    const bool small = left <= share;
+    if (stats.lost > 0)
+      frame_.stats.remeshed_because = std::to_string(stats.lost) + " vertices could not be put on the new skin";
+    else if (!mendable)
+      frame_.stats.remeshed_because = "a component or void vanished that is not a component of its own in the frame before";
+    else if (!small)
+      frame_.stats.remeshed_because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
+                                      std::to_string(static_cast<long>(share)) + ")";
     if (!(mendable && small && repair_locally(next, moved.mesh, moved.failing, local))) {
       before_remesh();
       frame_.stats.crowded =

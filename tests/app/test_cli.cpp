@@ -478,11 +478,20 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   // frames.jsonl: one object per frame with the fields a user plots.
   std::ifstream jsonl(dir + "/frames.jsonl");
   int frames = 0;
-  long from_scratch = 0, repaired = 0;
+  long from_scratch = 0, repaired = 0, remeshed = 0;
   while (std::getline(jsonl, line)) {
     const auto j = nlohmann::json::parse(line);
     from_scratch += j.value("full_rebuild", false);
     repaired += j.value("repaired", false);
+    // A frame remeshed whole says why; one that was not has no reason.
+    REQUIRE(j.contains("remeshed"));
+    REQUIRE(j.contains("remeshed_because"));
+    if (j["remeshed"].get<bool>()) {
+      ++remeshed;
+      CHECK(!j["remeshed_because"].get<std::string>().empty());
+    } else {
+      CHECK(j["remeshed_because"].is_null());
+    }
     for (const char* key : {"t", "file", "vertices", "triangles", "min_angle", "share_below_bound", "moved",
                             "relocated", "inserted", "removed", "repairs", "full_rebuild", "max_onsurf_error",
                             "oracle_uncertified", "components", "euler", "seconds"})
@@ -500,6 +509,7 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
     ++frames;
   }
   CHECK(frames == 4);
+  CHECK(remeshed >= 1);  // t = 1, on the target's own complex
   std::ifstream pvd(dir + "/frames.pvd");
   std::stringstream pvd_text;
   pvd_text << pvd.rdbuf();
