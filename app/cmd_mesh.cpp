@@ -160,7 +160,8 @@ void print_summary(const MeshCommandOptions& o, const GuaranteeReport& g, const 
   std::cout << "  on-surface error: max " << g.surface_error.max << " A, mean " << g.surface_error.mean
             << " A (oracle)\n"
             << "  guarantees:  angle >= " << o.meshing.min_angle << " deg, vertices on the skin, closed "
-            << "oriented manifold" << (g.no_self_intersections ? ", no self-intersections" : "") << ": all hold\n"
+            << "oriented manifold" << (g.no_self_intersections ? ", no self-intersections" : "")
+            << (g.topology ? ", the skin's topology" : "") << ": all hold\n"
             << "  time:        " << seconds["total"].get<double>() << " s (complex "
             << seconds["complex"].get<double>() << ", meshing " << seconds["meshing"].get<double>() << ", grading "
             << seconds["grading"].get<double>() << ")\n";
@@ -201,6 +202,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   GuaranteeOptions bounds;
   bounds.min_angle = meshing.min_angle;
   bounds.self_intersections = o.no_self_intersections ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
+  bounds.topology = !o.outer_only;  // the voids' surfaces are dropped: not the skin's topology
   const GuaranteeReport g = check_guarantees(mesh, balls, o.molecule.shrink, bounds);
   const SkinArea skin = skin_area(complex, mesh);
   const double seconds_grading = seconds_since(grade_start);

@@ -200,44 +200,21 @@ struct FrameReference {
   }
 };
 
-// Each vertex's distance to the skin of B(t) by the morph oracle, which
-// knows neither the morph's complex nor its live pairs. A point the oracle
-// cannot certify (a KKT gap left by both its solves) is measured instead on
-// the complex of B(t)'s balls built from scratch (a regular triangulation,
-// not the morph's overlay), and counted in `uncertified`.
-double largest_error(const SurfaceMesh& mesh, const FrameReference& reference, double t, long& uncertified) {
-  std::vector<double> off(mesh.vertices.size());
-  std::vector<char> certified(mesh.vertices.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v) {
-      const MorphOracleResult e = reference.oracle.evaluate(mesh.vertices[v], t);
-      off[v] = e.distance();
-      certified[v] = e.certified;
-    }
-  });
-  uncertified = std::count(certified.begin(), certified.end(), 0);
-  if (uncertified > 0) {
-    const SkinComplex own = build_skin_complex(reference.balls_at(t), {reference.shrink});
-    for (size_t v = 0; v < off.size(); ++v)
-      if (!certified[v]) {
-        const SkinEval e = own.evaluate(mesh.vertices[v]);
-        const double g = e.gradient.norm();
-        off[v] = g > 0 ? std::abs(e.value) / g : INFINITY;
-      }
-  }
-  return off.empty() ? 0.0 : *std::max_element(off.begin(), off.end());
-}
-
-FrameCheck check_frame(const SurfaceMesh& mesh, const FrameReference& reference, double t, double min_angle,
-                       bool self_intersections) {
-  FrameCheck c;
-  GradeOptions grade;
-  grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
-  c.quality = grade_mesh(mesh, grade);
-  c.max_error = largest_error(mesh, reference, t, c.uncertified);
-  c.skin = skin_topology(reference.balls_at(t));
-  judge_frame(c, mesh, min_angle, self_intersections);
-  return c;
+// The frame against the skin of B(t): distances by the morph oracle, which
+// knows neither the morph's complex nor its live pairs (a point it cannot
+// certify is measured on the complex of B(t)'s balls built from scratch, a
+// regular triangulation, not the morph's overlay); the topology from B(t)'s
+// balls.
+FrameCheck check_blend_frame(const SurfaceMesh& mesh, const FrameReference& reference, double t, double min_angle,
+                             bool self_intersections) {
+  SkinReference skin;
+  skin.balls = reference.balls_at(t);
+  skin.shrink = reference.shrink;
+  skin.oracle = [&reference, t](const Eigen::Vector3d& x) {
+    const MorphOracleResult e = reference.oracle.evaluate(x, t);
+    return SkinDistance{e.distance(), e.certified};
+  };
+  return check_frame(mesh, skin, min_angle, self_intersections);
 }
 
 // The m x n morph's frames.jsonl line: the common fields and its events.
@@ -507,7 +484,7 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
   const auto finish = [&]() {
     checking.wait();
     const json line = blend_frame_json(pending.frame.stats, check, out.files.listed_file(pending.index));
-    if (!check.holds) {
+    if (!check.holds()) {
       out.shown.finish();
       std::cerr << "skinmesh: error: frame " << pending.index << " (t = " << pending.t
                 << ") fails a guarantee; nothing written\n"
@@ -526,7 +503,7 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
     BlendFrame made = snapshot_blend(morph, k, times[k]);
     if (k > 0 && !finish()) return false;
     pending = std::move(made);
-    checking.run([&] { check = check_frame(pending.frame.mesh, reference, pending.t, min_angle, self_intersections); });
+    checking.run([&] { check = check_blend_frame(pending.frame.mesh, reference, pending.t, min_angle, self_intersections); });
   }
   return finish();
 }

@@ -189,16 +189,20 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees) {
   return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
 }
 
-void judge_frame(FrameCheck& c, const SurfaceMesh& mesh, double min_angle, bool self_intersections) {
+FrameCheck check_frame(const SurfaceMesh& mesh, const SkinReference& skin, double min_angle, bool self_intersections) {
+  GuaranteeOptions o;
+  o.min_angle = min_angle;
+  o.on_skin_tolerance = kFrameOnSkinTolerance;
+  o.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
+  FrameCheck c;
+  c.guarantees = check_guarantees(mesh, skin, o);
   c.share_below_bound = share_below(mesh, min_angle);
-  const MeshQuality& q = c.quality;
-  c.holds = q.triangles > 0 && q.min_angle >= min_angle - 1e-9 && q.closed && q.manifold && q.oriented &&
-            q.volume > 0 && (!self_intersections || q.self_intersecting_pairs == 0) && c.max_error <= 1e-8 &&
-            q.components == c.skin.components && q.cavities == c.skin.voids && q.euler == c.skin.euler;
+  return c;
 }
 
 json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
-  const MeshQuality& q = c.quality;
+  const MeshQuality& q = c.guarantees.quality;
+  const SkinTopology skin = c.guarantees.skin.value_or(SkinTopology{});
   return {{"t", s.t},
           {"file", file},
           {"vertices", s.vertices},
@@ -218,12 +222,12 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"full_rebuild", s.full_rebuild},
           {"remeshed", s.remeshed},
           {"remeshed_because", s.remeshed ? json(s.remeshed_because) : json(nullptr)},
-          {"max_onsurf_error", c.max_error},
-          {"oracle_uncertified", c.uncertified},
+          {"max_onsurf_error", c.guarantees.surface_error.max},
+          {"oracle_uncertified", c.guarantees.surface_error.uncertified},
           {"components", q.components},
           {"voids", q.cavities},
           {"euler", q.euler},
-          {"skin_topology", {{"components", c.skin.components}, {"voids", c.skin.voids}, {"euler", c.skin.euler}}},
+          {"skin_topology", {{"components", skin.components}, {"voids", skin.voids}, {"euler", skin.euler}}},
           {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
           {"seconds", s.seconds},
           {"seconds_complex", s.seconds_complex},
@@ -265,34 +269,7 @@ MadeFrame snapshot(const MovingBalls& moving, size_t k) {
 }
 
 FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self_intersections) {
-  const SurfaceMesh& mesh = made.frame.mesh;
-  FrameCheck c;
-  GradeOptions grade;
-  grade.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
-  c.quality = grade_mesh(mesh, grade);
-  c.skin = skin_topology(made.balls);
-  const SkinOracle oracle(made.balls, made.shrink);
-  std::vector<double> off(mesh.vertices.size());
-  std::vector<char> certified(mesh.vertices.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, off.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v) {
-      const OracleResult e = oracle.evaluate(mesh.vertices[v]);
-      certified[v] = e.certified;
-      off[v] = e.distance();
-    }
-  });
-  c.uncertified = std::count(certified.begin(), certified.end(), 0);
-  if (c.uncertified > 0) {  // measured on the complex of the frame's balls built from scratch, and counted
-    const SkinComplex own = build_skin_complex(made.balls, {made.shrink});
-    for (size_t v = 0; v < off.size(); ++v)
-      if (!certified[v]) {
-        const SkinEval e = own.evaluate(mesh.vertices[v]);
-        off[v] = e.gradient.norm() > 0 ? std::abs(e.value) / e.gradient.norm() : INFINITY;
-      }
-  }
-  c.max_error = off.empty() ? 0.0 : *std::max_element(off.begin(), off.end());
-  judge_frame(c, mesh, min_angle, self_intersections);
-  return c;
+  return check_frame(made.frame.mesh, SkinReference{made.balls, made.shrink, {}}, min_angle, self_intersections);
 }
 
 json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
@@ -343,7 +320,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
     checking.wait();
     const FrameStats& st = pending.frame.stats;
     const json line = moving_frame_json(st, check, files.listed_file(pending.index));
-    if (!check.holds) {
+    if (!check.holds()) {
       result.failed_frame = line;
       result.failed_index = pending.index;
       return false;

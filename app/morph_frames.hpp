@@ -15,6 +15,7 @@
 #include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include <nlohmann/json.hpp>
@@ -94,19 +95,18 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees);
 // left at the pace of the latest frames (`pace` has counted this one).
 void print_progress(ProgressLine& line, const PaceEstimate& pace, size_t total, const FrameStats& s, long repairs);
 
-// What is measured of every frame before it is written, either kind of morph.
+// What is measured of every frame before it is written, either kind of
+// morph: the guarantees every mesh is checked for (check_guarantees), with
+// the frame's skin, and the share of triangles under the angle bound.
 struct FrameCheck {
-  MeshQuality quality;
-  SkinTopology skin;             // of the frame's balls, from their alpha complex: the frame must have it
-  double max_error = 0;          // distance of the vertices to the frame's skin by an oracle, Angstrom
-  long uncertified = 0;          // vertices the oracle could not certify (measured on a complex built from scratch)
-  double share_below_bound = 0;  // of the triangles, those whose smallest angle is under the bound
-  bool holds = false;
+  GuaranteeReport guarantees;
+  double share_below_bound = 0;
+  bool holds() const { return guarantees.all_hold(); }
 };
-// Fills share_below_bound and holds from the rest: the angle bound, closed
-// oriented manifold enclosing positive volume, no self-intersections (when
-// checked), every vertex within 1e-8 A, and the skin's topology.
-void judge_frame(FrameCheck& c, const SurfaceMesh& mesh, double min_angle, bool self_intersections);
+// Every vertex of a frame within this of the frame's skin (Angstrom).
+constexpr double kFrameOnSkinTolerance = 1e-8;
+// The frame checked against `skin`: every guarantee, the topology included.
+FrameCheck check_frame(const SurfaceMesh& mesh, const SkinReference& skin, double min_angle, bool self_intersections);
 // The frames.jsonl fields both kinds of morph write.
 nlohmann::json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file);
 

@@ -88,7 +88,8 @@ nlohmann::json guarantees_json(const GuaranteeReport& g) {
   return {{"min_angle_at_least_bound", g.angle},
           {"vertices_on_skin_within_1e-9", g.on_skin},
           {"closed_oriented_manifold", g.closed_oriented_manifold},
-          {"no_self_intersections", g.no_self_intersections ? json(*g.no_self_intersections) : json(nullptr)}};
+          {"no_self_intersections", g.no_self_intersections ? json(*g.no_self_intersections) : json(nullptr)},
+          {"topology_of_skin", g.topology ? json(*g.topology) : json(nullptr)}};
 }
 
 void print_quality_summary(std::ostream& out, const std::string& name, const MeshQuality& q) {

@@ -29,7 +29,7 @@ nlohmann::json to_json(const MeshQuality& q);
 
 // {"max", "mean", "uncertified"}.
 nlohmann::json to_json(const SurfaceError& e);
-// Each guarantee true or false (no_self_intersections null when not checked).
+// Each guarantee true or false (no_self_intersections and topology_of_skin null when not checked).
 nlohmann::json guarantees_json(const GuaranteeReport& g);
 
 // The skin's own area beside the triangles' (skin_area.hpp): {"skin",

@@ -18,6 +18,7 @@ TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where bro
   REQUIRE(r.status == MeshingStatus::ok);
   const GuaranteeReport good = check_guarantees(r.mesh, balls, 0.5);
   CHECK(good.all_hold());
+  CHECK(good.topology == std::optional<bool>(true));
   CHECK(good.surface_error.max <= 1e-9);
   CHECK(good.quality.min_angle >= 30.0 - 1e-9);
 
@@ -49,6 +50,33 @@ TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where bro
     const GuaranteeReport g = check_guarantees(r.mesh, balls, 0.5, stricter);
     CHECK_FALSE(g.angle);
     CHECK(g.on_skin);
+  }
+  SECTION("a skin with a second component the mesh lacks") {
+    std::vector<Ball> more = balls;  // a ball 100 A off: the skin near pept is unchanged
+    more.push_back(Ball{balls[0].center + Eigen::Vector3d(100, 0, 0), 4.0});
+    const GuaranteeReport g = check_guarantees(r.mesh, more, 0.5);
+    REQUIRE(g.skin.has_value());
+    CHECK(g.skin->components == good.skin->components + 1);
+    CHECK(g.topology == std::optional<bool>(false));
+    CHECK(g.on_skin);
+    CHECK(g.closed_oriented_manifold);
+    CHECK_FALSE(g.all_hold());
+    GuaranteeOptions no_topology;
+    no_topology.topology = false;
+    const GuaranteeReport skipped = check_guarantees(r.mesh, more, 0.5, no_topology);
+    CHECK_FALSE(skipped.topology.has_value());
+    CHECK(skipped.all_hold());
+  }
+  SECTION("the skin given by another oracle: its distances, and the complex where it does not certify") {
+    SkinReference skin{balls, 0.5, [](const Eigen::Vector3d&) { return SkinDistance{0.02, true}; }};
+    const GuaranteeReport off = check_guarantees(r.mesh, skin);
+    CHECK(off.surface_error.max == 0.02);
+    CHECK_FALSE(off.on_skin);
+    skin.oracle = [](const Eigen::Vector3d&) { return SkinDistance{5.0, false}; };
+    const GuaranteeReport measured = check_guarantees(r.mesh, skin);
+    CHECK(measured.surface_error.uncertified == static_cast<long>(r.mesh.vertices.size()));
+    CHECK(measured.surface_error.max <= 1e-9);  // on the complex built from scratch, not the oracle's 5 A
+    CHECK(measured.all_hold());
   }
   SECTION("the self-intersection check skipped is reported as not made") {
     GuaranteeOptions skip;

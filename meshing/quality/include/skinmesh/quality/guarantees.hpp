@@ -1,40 +1,73 @@
 // The mesher's guarantees, measured on a finished mesh by means independent
 // of the mesher: every smallest angle at least the bound, every vertex on the
-// skin (the oracle of docs/math.md section 2), a closed, consistently
-// oriented 2-manifold enclosing positive volume, and no self-intersections
-// (exact, CGAL). One check for `skinmesh mesh`, `skinmesh volume`, the tests
-// and every frame of a morph.
+// skin (an oracle that builds no triangulation: docs/math.md section 2, or
+// section 4 for a frame of the m x n morph), a closed, consistently oriented
+// 2-manifold enclosing positive volume, no self-intersections (exact,
+// CGAL), and the skin's topology: components, voids and Euler characteristic
+// those counted from the alpha complex of its balls (skin_topology). One
+// check for `skinmesh mesh`, `skinmesh volume`, the tests and every frame of
+// a morph.
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 #include "skinmesh/quality/on_surface_error.hpp"
 
+#include <Eigen/Core>
+
+#include <functional>
 #include <optional>
 #include <vector>
 
 namespace skinmesh {
 
+// A point's distance to the skin by an oracle (Angstrom), and whether the
+// oracle certified it.
+struct SkinDistance {
+  double distance = 0;
+  bool certified = false;
+};
+
+// The skin a mesh claims to approximate, as the check sees it.
+struct SkinReference {
+  // Its balls: the topology comes from their alpha complex, and a vertex the
+  // oracle cannot certify is measured on their complex built from scratch.
+  std::vector<Ball> balls;
+  double shrink = 0.5;
+  // The oracle; empty: the static oracle of `balls` (SkinOracle).
+  std::function<SkinDistance(const Eigen::Vector3d&)> oracle;
+};
+
 struct GuaranteeOptions {
   double min_angle = 30.0;           // degrees: the bound every triangle's smallest angle must meet
-  double on_skin_tolerance = 1e-9;   // Angstrom: largest oracle distance of a vertex from the skin
+  double on_skin_tolerance = 1e-9;   // Angstrom: largest distance of a vertex from the skin
   SelfIntersectionCheck self_intersections = SelfIntersectionCheck::exact;
+  bool topology = true;              // components, voids and Euler characteristic those of the skin
 };
 
 struct GuaranteeReport {
   MeshQuality quality;                         // the full grade of the mesh
-  SurfaceError surface_error;                  // oracle distances of the vertices
+  // Distances of the vertices: by the oracle, and where it could not
+  // certify (counted in `uncertified`), on the balls' complex built from scratch.
+  SurfaceError surface_error;
+  std::optional<SkinTopology> skin;            // the skin's topology, when checked
   bool angle = false;                          // some triangle, and every smallest angle >= the bound
-  bool on_skin = false;                        // every vertex within the tolerance (uncertified ones counted in surface_error)
+  bool on_skin = false;                        // every vertex within the tolerance
   bool closed_oriented_manifold = false;       // closed, manifold, consistently oriented, positive volume
   std::optional<bool> no_self_intersections;   // empty when the check was skipped
+  std::optional<bool> topology;                // empty when the check was skipped
   bool all_hold() const {
-    return angle && on_skin && closed_oriented_manifold && no_self_intersections.value_or(true);
+    return angle && on_skin && closed_oriented_manifold && no_self_intersections.value_or(true) &&
+           topology.value_or(true);
   }
 };
 
-// `balls` and `shrink` define the skin the mesh claims to approximate.
+GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const SkinReference& skin,
+                                 const GuaranteeOptions& options = {});
+
+// The skin of `balls` at `shrink`, by the static oracle.
 GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const std::vector<Ball>& balls, double shrink,
                                  const GuaranteeOptions& options = {});
 
