@@ -18,6 +18,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <map>
+#include <memory>
 #include <utility>
 
 namespace skinmesh {
@@ -71,6 +74,62 @@ MeshingOptions with_size_margin(MeshingOptions o, double margin) {
 
 }  // namespace
 
+// The morph's state and its steps: Morph's public calls forward here.
+struct Morph::Impl {
+  Impl(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
+       const MorphOptions& options);
+  const MorphFrame& advance_to(double t, double next_t);
+  std::vector<std::array<int, 2>> vertex_atoms() const;
+  bool too_dense(const SkinComplex& next, const SurfaceMesh& mesh) const;
+  void rebuild_thinned(const SkinComplex& next, double t);
+  void rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t);
+  void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
+  bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
+  struct EditCounts {
+    long split = 0, flipped = 0, contracted = 0;
+  };
+  long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+                     std::vector<char>& drop, EditCounts& counts);
+  std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
+                                  std::vector<char>& stayed) const;
+  std::vector<char> drop_vanished(double t, const std::vector<char>& stayed, SurfaceMesh& moved,
+                                  std::vector<char>& lost, FrameStats& stats);
+  bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
+                      const detail::LocalRepairOptions& local);
+
+  void reseat(const SkinComplex& next, FrameStats& stats);
+  SkinComplex overlay_at(double t) const;
+  void overlay_at(double t, SkinComplex& out) const;  // into out's storage (see with_balls)
+  std::vector<SkinComplex::KnownCell> known_cells(double t) const;  // the overlay cells' centres and sizes at t
+  void finish_frame(double t, Clock::time_point start);
+  bool vanishing_left(double t, const std::vector<char>& handled) const;
+  // A frame after transport, relaxation and judging, before its repair.
+  struct Transported {
+    SurfaceMesh mesh;
+    std::vector<char> failing;        // per triangle
+    std::vector<char> drop;           // per vertex: lost (removed at a whole-frame remesh)
+    std::vector<char> handled;        // per event: its vanishing component was dropped (drop_vanished)
+    long first_new_id = 0, before = 0;  // the first id this frame may give; vertices of the frame before
+  };
+  void mend_frame(const SkinComplex& next, double t, Transported& moved, const std::function<void()>& before_remesh);
+
+  std::vector<Ball> source_, target_;
+  std::vector<BallPair> pairs_;
+  SkinComplex middle_, current_;
+  SkinComplex spare_;  // the complex of the frame before last: storage for the next frame's
+  double spare_t_ = -1;  // the frame spare_ was moved to ahead (advance_to's next_t); -1: none
+  bool on_overlay_ = true;  // current_ is the overlay complex (cells numbered as middle_)
+  MorphOptions options_;
+  std::vector<CellSize> sizes_;  // per cell of middle_: its size and centre as functions of t
+  std::vector<TopologyEvent> events_;
+  MorphFrame frame_;
+  double t_ = 0;
+  long next_id_ = 0;
+  // Thinning contractions the edits were refused, kept for the next frame's
+  // (detail::RefusedEdges in surgery.hpp).
+  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;
+};
+
 MeshingOptions MorphOptions::repair_criteria() const {
   MeshingOptions r = with_size_margin(frames, repair_size_margin);
   r.min_angle = std::min(30.0, frames.min_angle + repair_angle_margin);
@@ -79,7 +138,7 @@ MeshingOptions MorphOptions::repair_criteria() const {
 
 MeshingOptions MorphOptions::first_criteria() const { return with_size_margin(first, first_size_margin); }
 
-Morph::Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
+Morph::Impl::Impl(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
              const MorphOptions& options)
     : source_(std::move(source)),
       target_(std::move(target)),
@@ -92,7 +151,7 @@ Morph::Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<Bal
   events_ = critical_events(topology_events(sizes_), sizes_, middle_, pairs_, oracle);
 }
 
-void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t) {
+void Morph::Impl::rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t) {
   SkinMeshResult made = mesh_skin(next, criteria);
   if (made.status != MeshingStatus::ok)
     throw MeshingFailed(made.status, "morph frame at t = " + std::to_string(t) + ": " + made.message);
@@ -105,14 +164,14 @@ void Morph::rebuild(const SkinComplex& next, const MeshingOptions& criteria, dou
 // More than max_over_fresh times the triangles of a fresh mesh of `next`'s
 // skin, as the mesher estimates it; the estimate (about 0.07 s on
 // ubiquitin) only where the cheap density measure passes the screen.
-bool Morph::too_dense(const SkinComplex& next, const SurfaceMesh& mesh) const {
+bool Morph::Impl::too_dense(const SkinComplex& next, const SurfaceMesh& mesh) const {
   if (!(detail::density_over_fresh(next, mesh, options_.frames) > options_.density_screen)) return false;
   const TriangleEstimate fresh = estimate_triangles(skin_area_profile(next), options_.frames);
   return static_cast<double>(mesh.triangles.size()) > options_.max_over_fresh * std::max(fresh.triangles, 1.0);
 }
 
 // The frame meshed afresh because it is too dense (too_dense).
-void Morph::rebuild_thinned(const SkinComplex& next, double t) {
+void Morph::Impl::rebuild_thinned(const SkinComplex& next, double t) {
   const long before = static_cast<long>(frame_.ids.size());
   const auto start = Clock::now();
   rebuild(next, options_.repair_criteria(), t);
@@ -125,7 +184,7 @@ void Morph::rebuild_thinned(const SkinComplex& next, double t) {
 // Transport (eq. 19) or, off the cell, projection onto the new skin from
 // the transported point. Returns per vertex 1 where it could not be put on
 // the skin (lost), else 0.
-std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
+std::vector<char> Morph::Impl::move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
                                        std::vector<char>& stayed) const {
   const size_t n = mesh.vertices.size();
   std::vector<char> state(n, 0);  // 0 moved, 1 lost, 2 relocated
@@ -165,7 +224,7 @@ std::vector<char> Morph::move_vertices(const SkinComplex& next, SurfaceMesh& mes
 // current frame, remeshed in patches (local_repair.hpp); false when an event
 // needs the whole frame, the seam does not hold or the topology is not what
 // the events say (the caller remeshes the frame).
-bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
+bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
                            const detail::LocalRepairOptions& local) {
   detail::LocalRepair r =
       detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
@@ -187,7 +246,7 @@ bool Morph::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, co
 // The failing triangles mended by edits of the mesh (surgery.hpp); `moved`,
 // `failing` and `drop` become the edited mesh's, and the frame's ids follow
 // its vertices. Returns how many triangles still fail.
-long Morph::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+long Morph::Impl::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                           std::vector<char>& drop, EditCounts& counts) {
   detail::Surgery s =
       detail::mend_by_edits(next, std::move(moved), failing, options_.frames, options_.repair.edits, &frame_.ids,
@@ -205,7 +264,7 @@ long Morph::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vect
 
 // Remeshes the frame from the transported vertices not dropped; false when
 // the mesher cannot (then the caller rebuilds from scratch).
-bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
+bool Morph::Impl::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
   std::vector<long> ids = frame_.ids;
   SkinMeshResult made = detail::remesh_keeping_ids(next, moved, drop, options_.repair_criteria(), ids, next_id_);
   if (made.status != MeshingStatus::ok) return false;
@@ -224,7 +283,7 @@ bool Morph::repair(const SkinComplex& next, const SurfaceMesh& moved, const std:
 // Every vertex projected onto the skin of another complex (the target's at
 // t = 1, the overlay after a first frame at t = 0), then the frame remeshed
 // from them: the cells of the two complexes are not the same cells.
-void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
+void Morph::Impl::reseat(const SkinComplex& next, FrameStats& stats) {
   const auto transport_start = Clock::now();
   SurfaceMesh moved = frame_.mesh;
   std::vector<char> lost(moved.vertices.size(), 0);
@@ -254,7 +313,7 @@ void Morph::reseat(const SkinComplex& next, FrameStats& stats) {
 
 // The whole frame remeshed from its transported vertices, or, when the
 // mesher cannot, meshed from scratch (counted as a full rebuild).
-void Morph::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
+void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
   if (repair(next, moved, drop)) return;
   const long before = static_cast<long>(frame_.mesh.vertices.size());
   rebuild(next, options_.repair_criteria(), frame_.stats.t);
@@ -262,7 +321,7 @@ void Morph::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved,
   frame_.stats.removed = before;
 }
 
-void Morph::finish_frame(double t, Clock::time_point start) {
+void Morph::Impl::finish_frame(double t, Clock::time_point start) {
   frame_.stats.density = detail::density_over_fresh(current_, frame_.mesh, options_.frames);
   if (!frame_.stats.full_rebuild && frame_.stats.density > options_.density_screen &&
       too_dense(current_, frame_.mesh)) {
@@ -281,7 +340,7 @@ void Morph::finish_frame(double t, Clock::time_point start) {
 // before it (vanishing.hpp) and dropped from `moved`, with its vertices'
 // ids and their entries in `lost`. Returns per event whether its component
 // was dropped.
-std::vector<char> Morph::drop_vanished(double t, const std::vector<char>& stayed, SurfaceMesh& moved,
+std::vector<char> Morph::Impl::drop_vanished(double t, const std::vector<char>& stayed, SurfaceMesh& moved,
                                        std::vector<char>& lost, FrameStats& stats) {
   std::vector<char> handled(events_.size(), 0);
   std::vector<detail::VanishingSphere> spheres;
@@ -321,7 +380,7 @@ std::vector<char> Morph::drop_vanished(double t, const std::vector<char>& stayed
 
 // Whether a component or void vanishes in (t_, t] that drop_vanished did
 // not drop (`handled`): the frame is then remeshed whole.
-bool Morph::vanishing_left(double t, const std::vector<char>& handled) const {
+bool Morph::Impl::vanishing_left(double t, const std::vector<char>& handled) const {
   for (size_t i = 0; i < events_.size(); ++i) {
     const TopologyEvent& e = events_[i];
     if (in_step(e, t_, t) && takes_a_sphere(e) && !handled[i]) return true;
@@ -329,7 +388,7 @@ bool Morph::vanishing_left(double t, const std::vector<char>& handled) const {
   return false;
 }
 
-const MorphFrame& Morph::advance_to(double t, double next_t) {
+const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
   if (!(t > t_ && t <= 1)) contract_error("advance_to: t must lie after the current frame and at most 1");
   const auto start = Clock::now();
   FrameStats stats;
@@ -403,7 +462,7 @@ const MorphFrame& Morph::advance_to(double t, double next_t) {
 // The transported frame made the frame at t: kept as it is, or repaired,
 // cheapest first (morph.hpp); `before_remesh` is called before the whole
 // frame is remeshed.
-void Morph::mend_frame(const SkinComplex& next, double t, Transported& moved,
+void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& moved,
                        const std::function<void()>& before_remesh) {
   const FrameStats stats = frame_.stats;  // as transported (the repairs add to frame_.stats)
   if (stats.events == 0 && stats.lost == 0 && stats.bad_triangles == 0) {
@@ -458,24 +517,24 @@ void Morph::mend_frame(const SkinComplex& next, double t, Transported& moved,
 // near t = 0 or 1 is a sliver and loses digits, enough to put a frame's
 // vertices off the skin by more than the 1e-8 A a frame is held to
 // (bench/morph_precision checks a frame against CGAL's skin sign).
-SkinComplex Morph::overlay_at(double t) const {
+SkinComplex Morph::Impl::overlay_at(double t) const {
   SkinComplex out;
   overlay_at(t, out);
   return out;
 }
 
-void Morph::overlay_at(double t, SkinComplex& out) const {
+void Morph::Impl::overlay_at(double t, SkinComplex& out) const {
   middle_.with_balls(interpolated_balls(source_, target_, pairs_, t), known_cells(t), out);
 }
 
-std::vector<SkinComplex::KnownCell> Morph::known_cells(double t) const {
+std::vector<SkinComplex::KnownCell> Morph::Impl::known_cells(double t) const {
   std::vector<SkinComplex::KnownCell> known;
   for (size_t c = 0; c < sizes_.size(); ++c)
     if (sizes_[c].overlay_cell) known.push_back({static_cast<int>(c), sizes_[c].center(t), sizes_[c].at(t)});
   return known;
 }
 
-std::vector<std::array<int, 2>> Morph::vertex_atoms() const {
+std::vector<std::array<int, 2>> Morph::Impl::vertex_atoms() const {
   const SurfaceMesh& mesh = frame_.mesh;
   std::vector<std::array<int, 2>> atoms(mesh.vertices.size());
   for (size_t v = 0; v < atoms.size(); ++v) {
@@ -487,26 +546,38 @@ std::vector<std::array<int, 2>> Morph::vertex_atoms() const {
   return atoms;
 }
 
+Morph::Morph(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Morph::Morph(Morph&&) noexcept = default;
+Morph& Morph::operator=(Morph&&) noexcept = default;
+Morph::~Morph() = default;
+
+const MorphFrame& Morph::advance_to(double t, double next_t) { return impl_->advance_to(t, next_t); }
+double Morph::t() const { return impl_->t_; }
+std::vector<std::array<int, 2>> Morph::vertex_atoms() const { return impl_->vertex_atoms(); }
+const MorphFrame& Morph::frame() const { return impl_->frame_; }
+const SkinComplex& Morph::complex() const { return impl_->current_; }
+const std::vector<TopologyEvent>& Morph::events() const { return impl_->events_; }
+const std::vector<BallPair>& Morph::pairs() const { return impl_->pairs_; }
+
 Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0, const MorphOptions& options) {
   if (!(t0 >= 0 && t0 < 1)) contract_error("prepare_morph: the first frame must lie in [0,1)");
   if (source.empty() || target.empty()) contract_error("prepare_morph: both ball sets must be non-empty");
   std::vector<BallPair> pairs = live_pairs(source, target);
   SkinComplex middle = build_skin_complex(interpolated_balls(source, target, pairs, 0.5), {options.shrink});
-  Morph morph(std::move(source), std::move(target), std::move(pairs), std::move(middle), options);
+  auto m = std::make_unique<Morph::Impl>(std::move(source), std::move(target), std::move(pairs), std::move(middle),
+                                         options);
   const auto start = Clock::now();
-  morph.on_overlay_ = t0 > 0;
-  morph.current_ = t0 > 0
-                       ? morph.overlay_at(t0)
-                       : build_skin_complex(morph.source_, {options.shrink});
-  morph.t_ = t0;
+  m->on_overlay_ = t0 > 0;
+  m->current_ = t0 > 0 ? m->overlay_at(t0) : build_skin_complex(m->source_, {options.shrink});
+  m->t_ = t0;
   const double seconds_complex = seconds_since(start);
   const auto mesh_start = Clock::now();
-  morph.rebuild(morph.current_, options.first_criteria(), t0);
-  morph.frame_.stats.seconds_complex = seconds_complex;
-  morph.frame_.stats.seconds_repair = seconds_since(mesh_start);  // meshed from scratch
-  morph.frame_.stats.inserted = static_cast<long>(morph.frame_.mesh.vertices.size());
-  morph.finish_frame(t0, start);
-  return morph;
+  m->rebuild(m->current_, options.first_criteria(), t0);
+  m->frame_.stats.seconds_complex = seconds_complex;
+  m->frame_.stats.seconds_repair = seconds_since(mesh_start);  // meshed from scratch
+  m->frame_.stats.inserted = static_cast<long>(m->frame_.mesh.vertices.size());
+  m->finish_frame(t0, start);
+  return Morph(std::move(m));
 }
 
 }  // namespace skinmesh

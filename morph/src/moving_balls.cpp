@@ -17,6 +17,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <numeric>
 #include <unordered_map>
 
@@ -393,7 +395,32 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
   return out;
 }
 
-MovingBalls::MovingBalls(std::vector<Ball> balls, const MovingOptions& options, double t) : options_(options) {
+// The engine's state and its steps: MovingBalls' public calls forward here.
+struct MovingBalls::Impl {
+  Impl(std::vector<Ball> balls, const MovingOptions& options, double t);
+  const MorphFrame& advance_to(std::vector<Ball> balls, double t);
+  void step(std::vector<Ball> balls);
+  void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
+              SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
+  std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved);
+  std::string mend_locally(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
+                           SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
+  bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
+                     SurfaceMesh& moved, std::vector<char>& lost, long& euler_change);
+  bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
+  MeshingOptions repair_criteria() const { return options_.frames; }
+
+  MovingOptions options_;
+  SkinComplex complex_;
+  SkinTopology topology_;
+  std::vector<int> critical_;  // cells of complex_ that are critical points inside the body (moving_balls.cpp)
+  MorphFrame frame_;
+  long next_id_ = 0;
+  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;  // detail::RefusedEdges
+  std::function<void(SurfaceMesh&, std::vector<long>&)> certificate_fault_;  // tests only: none
+};
+
+MovingBalls::Impl::Impl(std::vector<Ball> balls, const MovingOptions& options, double t) : options_(options) {
   if (balls.empty()) contract_error("MovingBalls: the ball set is empty");
   check_balls(balls, "MovingBalls");
   if (!(options.max_step > 0) || !(options.continuity >= 0))
@@ -424,14 +451,28 @@ MovingBalls::MovingBalls(std::vector<Ball> balls, const MovingOptions& options, 
   s.seconds = seconds_since(start);
 }
 
-const MorphFrame& MovingBalls::advance_to(const std::vector<Eigen::Vector3d>& centres, double t) {
-  std::vector<Ball> balls = complex_.balls();
-  if (centres.size() != balls.size()) contract_error("MovingBalls::advance_to: the number of centres differs");
-  for (size_t i = 0; i < balls.size(); ++i) balls[i].center = centres[i];
-  return advance_to(std::move(balls), t);
-}
+MovingBalls::MovingBalls(std::vector<Ball> balls, const MovingOptions& options, double t)
+    : impl_(std::make_unique<Impl>(std::move(balls), options, t)) {}
+MovingBalls::MovingBalls(MovingBalls&&) noexcept = default;
+MovingBalls& MovingBalls::operator=(MovingBalls&&) noexcept = default;
+MovingBalls::~MovingBalls() = default;
 
 const MorphFrame& MovingBalls::advance_to(std::vector<Ball> balls, double t) {
+  return impl_->advance_to(std::move(balls), t);
+}
+const MorphFrame& MovingBalls::frame() const { return impl_->frame_; }
+const SkinComplex& MovingBalls::complex() const { return impl_->complex_; }
+const std::vector<Ball>& MovingBalls::balls() const { return impl_->complex_.balls(); }
+const SkinTopology& MovingBalls::topology() const { return impl_->topology_; }
+
+const MorphFrame& MovingBalls::advance_to(const std::vector<Eigen::Vector3d>& centres, double t) {
+  std::vector<Ball> balls = impl_->complex_.balls();
+  if (centres.size() != balls.size()) contract_error("MovingBalls::advance_to: the number of centres differs");
+  for (size_t i = 0; i < balls.size(); ++i) balls[i].center = centres[i];
+  return impl_->advance_to(std::move(balls), t);
+}
+
+const MorphFrame& MovingBalls::Impl::advance_to(std::vector<Ball> balls, double t) {
   const std::vector<Ball> from = complex_.balls();
   if (balls.size() != from.size()) contract_error("MovingBalls::advance_to: the number of balls differs");
   check_balls(balls, "MovingBalls::advance_to");
@@ -465,14 +506,15 @@ const MorphFrame& MovingBalls::advance_to(std::vector<Ball> balls, double t) {
 }
 
 std::vector<int> MovingBalls::vertex_balls() const {
-  std::vector<int> owner(frame_.mesh.vertices.size());
-  for (size_t v = 0; v < owner.size(); ++v) owner[v] = complex_.owning_ball(frame_.mesh.vertices[v], frame_.mesh.cells[v]);
+  const MorphFrame& f = impl_->frame_;
+  std::vector<int> owner(f.mesh.vertices.size());
+  for (size_t v = 0; v < owner.size(); ++v) owner[v] = impl_->complex_.owning_ball(f.mesh.vertices[v], f.mesh.cells[v]);
   return owner;
 }
 
 // One internal step: the new complex, every vertex moved onto its skin,
 // judged, mended and certified (moving_balls.hpp).
-void MovingBalls::step(std::vector<Ball> balls) {
+void MovingBalls::Impl::step(std::vector<Ball> balls) {
   FrameStats& s = frame_.stats;
   auto stage = Clock::now();
   SkinComplex next = build_skin_complex(std::move(balls), {options_.shrink});
@@ -531,7 +573,7 @@ void MovingBalls::step(std::vector<Ball> balls) {
 
 // The moved step made the frame: kept as it is, or mended, cheapest first
 // (moving_balls.hpp); throws Error when no mesh of the step can be certified.
-void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
+void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
                          SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed) {
   const std::string because = mend_locally(next, topology, critical, moved, lost, stayed);
   if (because.empty()) return;
@@ -562,7 +604,7 @@ void MovingBalls::repair(const SkinComplex& next, const SkinTopology& topology, 
 
 // Per triangle of `moved`, whether it fails the frame criteria, after the
 // corners of those that failed were relaxed along the skin once.
-std::vector<char> MovingBalls::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved) {
+std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved) {
   FrameStats& s = frame_.stats;
   auto stage = Clock::now();
   std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
@@ -597,7 +639,7 @@ std::vector<char> MovingBalls::judge_and_relax(const SkinComplex& next, SurfaceM
 // "" when they made a certified frame, else why the step must be remeshed
 // whole; `moved` and `lost` are then the mesh to remesh from and its lost
 // vertices.
-std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopology& topology,
+std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinTopology& topology,
                                       const std::vector<int>& critical, SurfaceMesh& moved, std::vector<char>& lost,
                                       const std::vector<char>& stayed) {
   FrameStats& s = frame_.stats;
@@ -677,7 +719,7 @@ std::string MovingBalls::mend_locally(const SkinComplex& next, const SkinTopolog
 // dropped from `moved` with their ids and their entries in `lost`;
 // `euler_change` gains 2 for each, since the repair counts from the mesh
 // without them. False when one is not found as a component of its own.
-bool MovingBalls::drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
+bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
                                 SurfaceMesh& moved, std::vector<char>& lost, long& euler_change) {
   std::vector<char> found;
   const std::vector<char> gone =
@@ -702,14 +744,14 @@ bool MovingBalls::drop_vanished(const std::vector<detail::VanishingSphere>& vani
 namespace detail {
 
 void inject_certificate_fault(MovingBalls& engine, std::function<void(SurfaceMesh&, std::vector<long>&)> fault) {
-  engine.certificate_fault_ = std::move(fault);
+  engine.impl_->certificate_fault_ = std::move(fault);
 }
 
 }  // namespace detail
 
 // The whole step remeshed from the moved vertices not dropped (remesh_skin);
 // false when the mesher cannot.
-bool MovingBalls::remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop,
+bool MovingBalls::Impl::remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop,
                          const MeshingOptions& criteria) {
   std::vector<long> ids = frame_.ids;
   SkinMeshResult made = detail::remesh_keeping_ids(next, moved, drop, criteria, ids, next_id_);

@@ -33,7 +33,6 @@
 
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/skin_complex.hpp"
-#include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/morph/events.hpp"
@@ -41,17 +40,12 @@
 #include "skinmesh/morph/repair_policy.hpp"
 
 #include <array>
-#include <functional>
-#include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace skinmesh {
-
-namespace detail {
-struct LocalRepairOptions;  // local_repair.hpp (private to morph/)
-}  // namespace detail
 
 struct MorphOptions {
   double shrink = 0.5;      // s in (0,1)
@@ -155,70 +149,28 @@ class Morph {
   // advance_to threw (a frame the mesher could not make: Error) holds no
   // valid frame and is not to be advanced again.
   const MorphFrame& advance_to(double t, double next_t = -1);
-  double t() const { return t_; }
+  double t() const;
   // Per vertex of the current frame: the source atom and the target atom it
   // belongs to (the pair of the cell's ball of least power distance, the
   // paper's surface point correspondence). At t = 0 and t = 1 the frame's
   // complex is one side's own: the other side's atom is -1 there.
   std::vector<std::array<int, 2>> vertex_atoms() const;
-  const MorphFrame& frame() const { return frame_; }
-  const SkinComplex& complex() const { return current_; }
-  const std::vector<TopologyEvent>& events() const { return events_; }
-  const std::vector<BallPair>& pairs() const { return pairs_; }
+  const MorphFrame& frame() const;
+  const SkinComplex& complex() const;
+  const std::vector<TopologyEvent>& events() const;
+  const std::vector<BallPair>& pairs() const;
+
+  // A Morph moves; it is not copied (its state holds three complexes).
+  Morph(Morph&&) noexcept;
+  Morph& operator=(Morph&&) noexcept;
+  ~Morph();
 
  private:
+  struct Impl;  // morph.cpp: the complexes, the events, the frame and the repair ladder
+  explicit Morph(std::unique_ptr<Impl> impl);
   friend Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0,
                              const MorphOptions& options);
-  Morph(std::vector<Ball> source, std::vector<Ball> target, std::vector<BallPair> pairs, SkinComplex middle,
-        const MorphOptions& options);
-  bool too_dense(const SkinComplex& next, const SurfaceMesh& mesh) const;
-  void rebuild_thinned(const SkinComplex& next, double t);
-  void rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t);
-  void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
-  bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
-  struct EditCounts {
-    long split = 0, flipped = 0, contracted = 0;
-  };
-  long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
-                     std::vector<char>& drop, EditCounts& counts);
-  std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
-                                  std::vector<char>& stayed) const;
-  std::vector<char> drop_vanished(double t, const std::vector<char>& stayed, SurfaceMesh& moved,
-                                  std::vector<char>& lost, FrameStats& stats);
-  bool repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
-                      const detail::LocalRepairOptions& local);
-
-  void reseat(const SkinComplex& next, FrameStats& stats);
-  SkinComplex overlay_at(double t) const;
-  void overlay_at(double t, SkinComplex& out) const;  // into out's storage (see with_balls)
-  std::vector<SkinComplex::KnownCell> known_cells(double t) const;  // the overlay cells' centres and sizes at t
-  void finish_frame(double t, Clock::time_point start);
-  bool vanishing_left(double t, const std::vector<char>& handled) const;
-  // A frame after transport, relaxation and judging, before its repair.
-  struct Transported {
-    SurfaceMesh mesh;
-    std::vector<char> failing;        // per triangle
-    std::vector<char> drop;           // per vertex: lost (removed at a whole-frame remesh)
-    std::vector<char> handled;        // per event: its vanishing component was dropped (drop_vanished)
-    long first_new_id = 0, before = 0;  // the first id this frame may give; vertices of the frame before
-  };
-  void mend_frame(const SkinComplex& next, double t, Transported& moved, const std::function<void()>& before_remesh);
-
-  std::vector<Ball> source_, target_;
-  std::vector<BallPair> pairs_;
-  SkinComplex middle_, current_;
-  SkinComplex spare_;  // the complex of the frame before last: storage for the next frame's
-  double spare_t_ = -1;  // the frame spare_ was moved to ahead (advance_to's next_t); -1: none
-  bool on_overlay_ = true;  // current_ is the overlay complex (cells numbered as middle_)
-  MorphOptions options_;
-  std::vector<CellSize> sizes_;  // per cell of middle_: its size and centre as functions of t
-  std::vector<TopologyEvent> events_;
-  MorphFrame frame_;
-  double t_ = 0;
-  long next_id_ = 0;
-  // Thinning contractions the edits were refused, kept for the next frame's
-  // (detail::RefusedEdges in surgery.hpp).
-  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;
+  std::unique_ptr<Impl> impl_;
 };
 
 // Live pairs, the complex of B(1/2), the topology events, and the first

@@ -35,7 +35,7 @@
 #include "skinmesh/morph/repair_policy.hpp"
 
 #include <functional>
-#include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -89,35 +89,23 @@ class MovingBalls {
   // The same with every ball's weight kept.
   const MorphFrame& advance_to(const std::vector<Eigen::Vector3d>& centres, double t = 0);
 
-  const MorphFrame& frame() const { return frame_; }
-  const SkinComplex& complex() const { return complex_; }
-  const std::vector<Ball>& balls() const { return complex_.balls(); }
-  const SkinTopology& topology() const { return topology_; }  // of balls(), which the frame's mesh has
+  const MorphFrame& frame() const;
+  const SkinComplex& complex() const;
+  const std::vector<Ball>& balls() const;
+  const SkinTopology& topology() const;  // of balls(), which the frame's mesh has
   // Per vertex of the frame: the ball it belongs to (of its cell's balls,
   // the one of least power distance).
   std::vector<int> vertex_balls() const;
 
- private:
-  void step(std::vector<Ball> balls);
-  void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
-              SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
-  std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved);
-  std::string mend_locally(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
-                           SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
-  bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
-                     SurfaceMesh& moved, std::vector<char>& lost, long& euler_change);
-  bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
-  MeshingOptions repair_criteria() const { return options_.frames; }
-  friend void detail::inject_certificate_fault(MovingBalls&, std::function<void(SurfaceMesh&, std::vector<long>&)>);
+  // An engine moves; it is not copied.
+  MovingBalls(MovingBalls&&) noexcept;
+  MovingBalls& operator=(MovingBalls&&) noexcept;
+  ~MovingBalls();
 
-  MovingOptions options_;
-  SkinComplex complex_;
-  SkinTopology topology_;
-  std::vector<int> critical_;  // cells of complex_ that are critical points inside the body (moving_balls.cpp)
-  MorphFrame frame_;
-  long next_id_ = 0;
-  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;  // detail::RefusedEdges
-  std::function<void(SurfaceMesh&, std::vector<long>&)> certificate_fault_;  // tests only: none
+ private:
+  struct Impl;  // moving_balls.cpp: the complex, the frame and the repair ladder
+  std::unique_ptr<Impl> impl_;
+  friend void detail::inject_certificate_fault(MovingBalls&, std::function<void(SurfaceMesh&, std::vector<long>&)>);
 };
 
 // Components, voids and Euler characteristic of a closed triangle mesh
