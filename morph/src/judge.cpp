@@ -1,9 +1,13 @@
 #include "judge.hpp"
 
 #include "skinmesh/core/error.hpp"
+#include "skinmesh/core/stopwatch.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <utility>
 
 namespace skinmesh::detail {
 
@@ -50,6 +54,37 @@ void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
   }
   const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
   for (size_t k = 0; k < at.size(); ++k) failing[at[k]] = verdicts[k];
+}
+
+Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,
+                       const MeshingOptions& criteria) {
+  Judged j;
+  auto stage = Clock::now();
+  j.failing = failing_triangles(complex, mesh, mesh.triangles, criteria);
+  j.failing_before_relax = std::count(j.failing.begin(), j.failing.end(), 1);
+  j.seconds_judge = seconds_since(stage);
+  if (j.failing_before_relax == 0 || relaxation.passes == 0) return j;
+  stage = Clock::now();
+  std::vector<char> corners(mesh.vertices.size(), 0);
+  for (size_t f = 0; f < j.failing.size(); ++f)
+    if (j.failing[f])
+      for (int v : mesh.triangles[f]) corners[static_cast<size_t>(v)] = 1;
+  std::vector<std::pair<Eigen::Vector3d, int>> before;  // each corner's place and cell
+  for (size_t v = 0; v < corners.size(); ++v)
+    if (corners[v]) before.emplace_back(mesh.vertices[v], mesh.cells[v]);
+  relax_tangentially(complex, mesh, relaxation, &corners);
+  j.seconds_relax = seconds_since(stage);
+  stage = Clock::now();
+  // Only triangles with a corner the relaxation moved can have changed verdict.
+  size_t k = 0;
+  for (size_t v = 0; v < corners.size(); ++v)
+    if (corners[v]) {
+      corners[v] = mesh.vertices[v] != before[k].first || mesh.cells[v] != before[k].second;
+      ++k;
+    }
+  rejudge_moved(complex, mesh, corners, criteria, j.failing);
+  j.seconds_judge += seconds_since(stage);
+  return j;
 }
 
 }  // namespace skinmesh::detail

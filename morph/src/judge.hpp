@@ -9,6 +9,7 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/relaxation.hpp"
 
 #include <array>
 #include <vector>
@@ -43,5 +44,19 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
 // corner's cell and the complex alone, so the others keep theirs.
 void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
                    const MeshingOptions& criteria, std::vector<char>& failing);
+
+// A transported frame judged, with relaxation only where it is needed (the
+// moving-balls engine, whose steps fail a few triangles where atoms meet):
+// every triangle judged, the corners of those that fail relaxed along the
+// skin (relaxation.hpp; none when options.passes is 0), and the triangles
+// those moves touched judged again. The other vertices stay on their
+// closed-form paths.
+struct Judged {
+  std::vector<char> failing;       // per triangle, after the relaxation
+  long failing_before_relax = 0;   // triangles failing as transported
+  double seconds_judge = 0, seconds_relax = 0;
+};
+Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,
+                       const MeshingOptions& criteria);
 
 }  // namespace skinmesh::detail

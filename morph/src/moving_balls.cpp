@@ -605,34 +605,12 @@ void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topo
 // Per triangle of `moved`, whether it fails the frame criteria, after the
 // corners of those that failed were relaxed along the skin once.
 std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved) {
+  detail::Judged j = detail::judge_and_relax(next, moved, options_.relaxation, options_.frames);
   FrameStats& s = frame_.stats;
-  auto stage = Clock::now();
-  std::vector<char> failing = detail::failing_triangles(next, moved, moved.triangles, options_.frames);
-  const long bad = std::count(failing.begin(), failing.end(), 1);
-  s.bad_triangles += bad;
-  s.seconds_judge += seconds_since(stage);
-  if (bad == 0 || options_.relaxation.passes == 0) return failing;
-  stage = Clock::now();
-  std::vector<char> corners(moved.vertices.size(), 0);
-  for (size_t f = 0; f < failing.size(); ++f)
-    if (failing[f])
-      for (int v : moved.triangles[f]) corners[static_cast<size_t>(v)] = 1;
-  std::vector<std::pair<Eigen::Vector3d, int>> before;  // each corner's place and cell
-  for (size_t v = 0; v < corners.size(); ++v)
-    if (corners[v]) before.emplace_back(moved.vertices[v], moved.cells[v]);
-  relax_tangentially(next, moved, options_.relaxation, &corners);
-  s.seconds_relax += seconds_since(stage);
-  stage = Clock::now();
-  // Only triangles with a corner the relaxation moved can have changed verdict.
-  size_t k = 0;
-  for (size_t v = 0; v < corners.size(); ++v)
-    if (corners[v]) {
-      corners[v] = moved.vertices[v] != before[k].first || moved.cells[v] != before[k].second;
-      ++k;
-    }
-  detail::rejudge_moved(next, moved, corners, options_.frames, failing);
-  s.seconds_judge += seconds_since(stage);
-  return failing;
+  s.bad_triangles += j.failing_before_relax;
+  s.seconds_judge += j.seconds_judge;
+  s.seconds_relax += j.seconds_relax;
+  return std::move(j.failing);
 }
 
 // Judging, relaxation, edits and a local patch (moving_balls.hpp). Returns
