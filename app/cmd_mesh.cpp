@@ -204,6 +204,7 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   bounds.self_intersections = o.no_self_intersections ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
   bounds.topology = !o.outer_only;  // the voids' surfaces are dropped: not the skin's topology
   const GuaranteeReport g = check_guarantees(mesh, balls, o.molecule.shrink, bounds);
+  const double seconds_checking = seconds_since(grade_start);
   const SkinArea skin = skin_area(complex, mesh);
   const double seconds_grading = seconds_since(grade_start);
 
@@ -235,7 +236,9 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
                    {"refining", s.seconds_refining},
                    {"contracting", s.seconds_contracting},
                    {"meshing", s.seconds_total},
-                   {"grading", seconds_grading}}}};
+                   {"grading", seconds_grading},
+                   {"checking", seconds_checking},
+                   {"skin_area", seconds_grading - seconds_checking}}}};
   if (!g.all_hold()) {
     std::cerr << "skinmesh: error: " << o.molecule.path << ": the mesh fails a guarantee (see below); nothing written\n"
               << json_text({{"guarantees", report["guarantees"]},
