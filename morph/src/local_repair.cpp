@@ -299,7 +299,7 @@ std::pair<long, long> components_and_euler(const SurfaceMesh& mesh) {
 
 // Drops the vertices no triangle uses and renumbers; origin maps each
 // vertex back to the mesh before (or -1).
-void compact(const SurfaceMesh& merged, size_t old_vertices, LocalRepair& out) {
+void compact(const SurfaceMesh& merged, size_t old_vertices, RepairResult& out) {
   std::vector<int> kept_from;
   out.mesh = used_part(merged, {}, kept_from);
   for (int v : kept_from) out.origin.push_back(static_cast<size_t>(v) < old_vertices ? v : -1);
@@ -466,10 +466,10 @@ bool topology_as_expected(const SurfaceMesh& before, const SurfaceMesh& after, c
 
 }  // namespace
 
-LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
+RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
-  LocalRepair out;
+  RepairResult out;
   // The frame is copied only when seeds are to be added to it.
   const bool births = std::any_of(options.changes.begin(), options.changes.end(),
                                   [](const TopologyChange& c) { return c.birth; });
@@ -490,9 +490,9 @@ LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& given,
                              "changes say";
         return out;
       }
-      out.patch_triangles = std::count(region.begin(), region.end(), 1);
+      out.counts.patch_triangles = std::count(region.begin(), region.end(), 1);
       compact(a.merged, given.vertices.size(), out);
-      out.repairs = a.repairs;
+      out.counts.insertions = a.repairs;
       out.ok = true;
       return out;
     }

@@ -7,6 +7,8 @@
 // repair reports failure and the caller grows the patch or remeshes the frame.
 #pragma once
 
+#include "repair_result.hpp"
+
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
@@ -17,15 +19,6 @@
 #include <vector>
 
 namespace skinmesh::detail {
-
-struct LocalRepair {
-  bool ok = false;
-  SurfaceMesh mesh;          // the whole frame after the repair
-  std::vector<long> origin;  // per vertex: its index in the mesh before, or -1 when inserted
-  long repairs = 0;          // refinement insertions
-  long patch_triangles = 0;  // triangles replaced
-  std::string failed_because;  // when !ok: which check gave up
-};
 
 // A place where the skin's topology changes between the frames (a critical
 // event's apex at the new frame): the triangles with a corner within
@@ -56,7 +49,8 @@ struct LocalRepairOptions {
 // the skin of `complex` (all zero is fine when options.changes is not
 // empty). The patch is refined to `repair` (stricter, for room before the
 // next failure); its new triangles must meet `accept`.
-LocalRepair repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+// The result: ok, or failed_because; counts.insertions and patch_triangles.
+RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options);
 

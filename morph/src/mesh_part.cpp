@@ -80,22 +80,30 @@ double density_over_fresh(const SkinComplex& complex, const SurfaceMesh& mesh, c
   return static_cast<double>(mesh.triangles.size()) / std::max(fresh, 1.0);
 }
 
-SkinMeshResult remesh_keeping_ids(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
-                                  const MeshingOptions& criteria, std::vector<long>& ids, long& next_id) {
+RepairResult remesh_from_vertices(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
+                                  const MeshingOptions& criteria) {
   std::vector<SkinSample> samples;
-  std::vector<long> sample_ids;
+  std::vector<long> sample_vertex;  // per sample: its vertex in `mesh`
   samples.reserve(mesh.vertices.size());
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     if (drop[v]) continue;
     samples.push_back({mesh.vertices[v], mesh.cells[v]});
-    sample_ids.push_back(ids[v]);
+    sample_vertex.push_back(static_cast<long>(v));
   }
   SkinMeshResult made = remesh_skin(complex, samples, criteria);
-  if (made.status != MeshingStatus::ok) return made;
-  ids.resize(made.mesh.vertices.size());
-  for (size_t v = 0; v < ids.size(); ++v)
-    ids[v] = made.origins[v] >= 0 ? sample_ids[static_cast<size_t>(made.origins[v])] : next_id++;
-  return made;
+  RepairResult out;
+  if (made.status != MeshingStatus::ok) {
+    out.failed_because = made.message;
+    return out;
+  }
+  out.ok = true;
+  out.origin.resize(made.mesh.vertices.size());
+  for (size_t v = 0; v < out.origin.size(); ++v)
+    out.origin[v] = made.origins[v] >= 0 ? sample_vertex[static_cast<size_t>(made.origins[v])] : -1;
+  out.counts.insertions = made.stats.inserted_size + made.stats.inserted_shape + made.stats.inserted_distance +
+                          made.stats.inserted_topology;
+  out.mesh = std::move(made.mesh);
+  return out;
 }
 
 }  // namespace skinmesh::detail

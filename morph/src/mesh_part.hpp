@@ -2,6 +2,8 @@
 // repair, the edits and the dropping of vanished components keep of a mesh.
 #pragma once
 
+#include "repair_result.hpp"
+
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
@@ -32,10 +34,10 @@ long mark_crowded(const SkinComplex& complex, const SurfaceMesh& mesh, const Mes
 // without bound, as it never removes a vertex.
 double density_over_fresh(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria);
 
-// The frame remeshed from its vertices not marked in `drop` (remesh_skin),
-// those kept carrying their `ids`, new ones taking next_id, next_id + 1, ...
-// `ids` becomes the result's (unchanged when the mesher cannot: status).
-SkinMeshResult remesh_keeping_ids(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
-                                  const MeshingOptions& criteria, std::vector<long>& ids, long& next_id);
+// The frame remeshed from its vertices not marked in `drop` (remesh_skin);
+// `origin` maps the result's vertices to `mesh`'s. Not ok (the mesher's
+// message in failed_because) when the mesher cannot.
+RepairResult remesh_from_vertices(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
+                                  const MeshingOptions& criteria);
 
 }  // namespace skinmesh::detail

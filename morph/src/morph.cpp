@@ -85,11 +85,8 @@ struct Morph::Impl {
   void rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t);
   void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
-  struct EditCounts {
-    long split = 0, flipped = 0, contracted = 0;
-  };
   long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
-                     std::vector<char>& drop, EditCounts& counts);
+                     std::vector<char>& drop);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
                                   std::vector<char>& stayed) const;
   std::vector<char> drop_vanished(double t, const std::vector<char>& stayed, SurfaceMesh& moved,
@@ -225,21 +222,15 @@ std::vector<char> Morph::Impl::move_vertices(const SkinComplex& next, SurfaceMes
 // needs the whole frame, the seam does not hold or the topology is not what
 // the events say (the caller remeshes the frame).
 bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
-                           const detail::LocalRepairOptions& local) {
-  detail::LocalRepair r =
+                                 const detail::LocalRepairOptions& local) {
+  detail::RepairResult r =
       detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
   if (!r.ok) {
     frame_.stats.remeshed_because = "the local patch failed: " + r.failed_because;
     return false;
   }
-  std::vector<long> ids(r.origin.size());  // inserted and removed are counted by ids (advance_to)
-  for (size_t v = 0; v < ids.size(); ++v)
-    ids[v] = r.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(r.origin[v])] : next_id_++;
-  frame_.stats.repaired = true;
-  frame_.stats.patch_triangles = r.patch_triangles;
-  frame_.stats.repairs = r.repairs;
+  detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);  // inserted and removed: by ids (advance_to)
   frame_.mesh = std::move(r.mesh);
-  frame_.ids = std::move(ids);
   return true;
 }
 
@@ -247,36 +238,27 @@ bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& mov
 // `failing` and `drop` become the edited mesh's, and the frame's ids follow
 // its vertices. Returns how many triangles still fail.
 long Morph::Impl::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
-                          std::vector<char>& drop, EditCounts& counts) {
-  detail::Surgery s =
-      detail::mend_by_edits(next, std::move(moved), failing, options_.frames, options_.repair.edits, &frame_.ids,
-                            &refused_thinning_);
-  std::vector<long> ids(s.origin.size());
-  for (size_t v = 0; v < ids.size(); ++v)
-    ids[v] = s.origin[v] >= 0 ? frame_.ids[static_cast<size_t>(s.origin[v])] : next_id_++;
-  frame_.ids = std::move(ids);
-  moved = std::move(s.mesh);
-  failing = std::move(s.failing);
+                                std::vector<char>& drop) {
+  detail::RepairResult r = detail::mend_by_edits(next, std::move(moved), failing, options_.frames,
+                                                 options_.repair.edits, &frame_.ids, &refused_thinning_);
+  detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);
+  moved = std::move(r.mesh);
+  failing = std::move(r.failing);
   drop.assign(moved.vertices.size(), 0);
-  counts = {s.splits, s.flips, s.contractions};
-  return s.left;
+  return r.left;
 }
 
 // Remeshes the frame from the transported vertices not dropped; false when
 // the mesher cannot (then the caller rebuilds from scratch).
 bool Morph::Impl::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
-  std::vector<long> ids = frame_.ids;
-  SkinMeshResult made = detail::remesh_keeping_ids(next, moved, drop, options_.repair_criteria(), ids, next_id_);
-  if (made.status != MeshingStatus::ok) return false;
-  const long kept = std::count_if(made.origins.begin(), made.origins.end(), [](long o) { return o >= 0; });
-  const MeshingStats& m = made.stats;
-  frame_.stats.repaired = true;
+  detail::RepairResult r = detail::remesh_from_vertices(next, moved, drop, options_.repair_criteria());
+  if (!r.ok) return false;
+  const long kept = std::count_if(r.origin.begin(), r.origin.end(), [](long o) { return o >= 0; });
+  detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);
   frame_.stats.remeshed = true;
-  frame_.stats.inserted = static_cast<long>(ids.size()) - kept;
+  frame_.stats.inserted = static_cast<long>(r.origin.size()) - kept;
   frame_.stats.removed = static_cast<long>(moved.vertices.size()) - kept;
-  frame_.stats.repairs = m.inserted_size + m.inserted_shape + m.inserted_distance + m.inserted_topology;
-  frame_.mesh = std::move(made.mesh);
-  frame_.ids = std::move(ids);
+  frame_.mesh = std::move(r.mesh);
   return true;
 }
 
@@ -478,8 +460,7 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
   local.policy = options_.repair.patch;
   const bool mendable = stats.lost == 0 && add_topology_changes(events_, sizes_, t_, t, moved.handled, local);
   long left = stats.bad_triangles;
-  EditCounts edited;
-  if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop, edited);
+  if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop);
   if (mendable && local.changes.empty() && left == 0) {
     frame_.mesh = std::move(moved.mesh);
     frame_.stats.repaired = true;
@@ -500,9 +481,6 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
       remesh_or_rebuild(next, moved.mesh, moved.drop);
     }
   }
-  frame_.stats.split = edited.split;
-  frame_.stats.flipped = edited.flipped;
-  frame_.stats.contracted = edited.contracted;
   // Counted by ids, as vertices an edit inserted may be gone again after
   // the repair that followed.
   const long first_new_id = moved.first_new_id;

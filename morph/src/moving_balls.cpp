@@ -621,11 +621,6 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
                                       const std::vector<int>& critical, SurfaceMesh& moved, std::vector<char>& lost,
                                       const std::vector<char>& stayed) {
   FrameStats& s = frame_.stats;
-  const auto follow = [&](const std::vector<long>& origin) {  // the frame's ids onto an edited mesh's vertices
-    std::vector<long> ids(origin.size());
-    for (size_t v = 0; v < ids.size(); ++v) ids[v] = origin[v] >= 0 ? frame_.ids[static_cast<size_t>(origin[v])] : next_id_++;
-    frame_.ids = std::move(ids);
-  };
   // Where the topology changed; a component or void that vanished is
   // dropped first (its sphere of triangles has no skin left to go to); one
   // that is not a component of its own in the step before becomes a place
@@ -652,17 +647,13 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   long left = std::count(failing.begin(), failing.end(), 1);
   const auto stage = Clock::now();
   if (left > 0 && options_.repair.edits.enabled) {
-    detail::Surgery edited =
+    detail::RepairResult edited =
         detail::mend_by_edits(next, std::move(moved), failing, options_.frames, options_.repair.edits, &frame_.ids,
                               &refused_thinning_);
-    follow(edited.origin);
+    detail::take_ids_and_counts(edited, frame_.ids, next_id_, s);
     moved = std::move(edited.mesh);
     failing = std::move(edited.failing);
     left = edited.left;
-    s.split += edited.splits;
-    s.flipped += edited.flips;
-    s.contracted += edited.contractions;
-    s.repaired = true;
   }
   lost.assign(moved.vertices.size(), 0);  // the edits renumbered the vertices; none is lost
   std::string because;
@@ -671,14 +662,12 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
               std::to_string(static_cast<long>(share)) + ")";
   } else if (left > 0 || !local.changes.empty()) {
-    detail::LocalRepair patched = detail::repair_locally(next, moved, failing, repair_criteria(), options_.frames, local);
+    detail::RepairResult patched =
+        detail::repair_locally(next, moved, failing, repair_criteria(), options_.frames, local);
     if (patched.ok) {
-      follow(patched.origin);
+      detail::take_ids_and_counts(patched, frame_.ids, next_id_, s);
       moved = std::move(patched.mesh);
       lost.assign(moved.vertices.size(), 0);
-      s.repaired = true;
-      s.patch_triangles += patched.patch_triangles;
-      s.repairs += patched.repairs;
     } else {
       because = "the local patch failed: " + patched.failed_because;
     }
@@ -730,12 +719,11 @@ void inject_certificate_fault(MovingBalls& engine, std::function<void(SurfaceMes
 // The whole step remeshed from the moved vertices not dropped (remesh_skin);
 // false when the mesher cannot.
 bool MovingBalls::Impl::remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop,
-                         const MeshingOptions& criteria) {
-  std::vector<long> ids = frame_.ids;
-  SkinMeshResult made = detail::remesh_keeping_ids(next, moved, drop, criteria, ids, next_id_);
-  if (made.status != MeshingStatus::ok) return false;
-  frame_.mesh = std::move(made.mesh);
-  frame_.ids = std::move(ids);
+                               const MeshingOptions& criteria) {
+  detail::RepairResult r = detail::remesh_from_vertices(next, moved, drop, criteria);
+  if (!r.ok) return false;
+  detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);
+  frame_.mesh = std::move(r.mesh);
   return true;
 }
 

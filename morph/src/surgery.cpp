@@ -69,7 +69,7 @@ class Editor {
     for (int f = 0; f < static_cast<int>(mesh_.triangles.size()); ++f) attach(f);
   }
 
-  Surgery run(const std::vector<char>& failing, const std::vector<long>* ids, RefusedEdges* refused);
+  RepairResult run(const std::vector<char>& failing, const std::vector<long>* ids, RefusedEdges* refused);
 
  private:
   const Triangle& tri(int f) const { return mesh_.triangles[static_cast<size_t>(f)]; }
@@ -378,7 +378,7 @@ void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<
   }
 }
 
-Surgery Editor::run(const std::vector<char>& failing, const std::vector<long>* ids, RefusedEdges* refused) {
+RepairResult Editor::run(const std::vector<char>& failing, const std::vector<long>* ids, RefusedEdges* refused) {
   std::deque<int> queue;
   for (size_t f = 0; f < failing.size(); ++f)
     if (failing[f]) queue.push_back(static_cast<int>(f));
@@ -407,7 +407,8 @@ Surgery Editor::run(const std::vector<char>& failing, const std::vector<long>* i
     }
   }
   if (options_.thin_below > 0) thin_crowded(seen, ids, refused);
-  Surgery out;
+  RepairResult out;
+  out.ok = true;
   std::vector<int> kept_from;
   out.mesh = used_part(mesh_, alive_, kept_from);
   for (int v : kept_from) out.origin.push_back(static_cast<size_t>(v) < vertices_before_ ? v : -1);
@@ -415,16 +416,16 @@ Surgery Editor::run(const std::vector<char>& failing, const std::vector<long>* i
     if (alive_[f])
       out.failing.push_back(seen.count(static_cast<int>(f)) && judge(static_cast<int>(f)) != Verdict::pass);
   out.left = std::count(out.failing.begin(), out.failing.end(), 1);
-  out.splits = splits_;
-  out.flips = flips_;
-  out.contractions = contractions_;
+  out.counts.splits = splits_;
+  out.counts.flips = flips_;
+  out.counts.contractions = contractions_;
   out.thin_tried = thin_tried_;
   return out;
 }
 
 }  // namespace
 
-Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
+RepairResult mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
                       const MeshingOptions& accept, const EditPolicy& options, const std::vector<long>* ids,
                       RefusedEdges* refused) {
   Editor editor(complex, std::move(mesh), accept, options);

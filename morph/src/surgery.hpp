@@ -13,6 +13,8 @@
 // however few triangles fail (docs/morph.md, "Mending by edits").
 #pragma once
 
+#include "repair_result.hpp"
+
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
@@ -29,21 +31,12 @@ namespace skinmesh::detail {
 // caller from frame to frame.
 using RefusedEdges = std::map<std::pair<long, long>, std::pair<double, int>>;
 
-struct Surgery {
-  SurfaceMesh mesh;             // the frame after the edits
-  std::vector<long> origin;     // per vertex: its index before, or -1 when inserted by a split
-  std::vector<char> failing;    // per triangle of `mesh`: still failing the criteria
-  long splits = 0, flips = 0, contractions = 0;
-  long thin_tried = 0;          // edges thinning tried to contract (not those skipped as refused before)
-  long left = 0;                // triangles still failing
-};
-
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
 // skin of `complex`; the others are taken to pass. With `ids` (per vertex of
 // `mesh`, stable from frame to frame) and `refused`, thinning skips the
 // edges refused before (EditPolicy::retry_shrink) and `refused` becomes
 // this frame's.
-Surgery mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
+RepairResult mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
                       const MeshingOptions& accept, const EditPolicy& options = {},
                       const std::vector<long>* ids = nullptr, RefusedEdges* refused = nullptr);
 

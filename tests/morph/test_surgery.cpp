@@ -51,7 +51,7 @@ TEST_CASE("edits: thinning skips an edge refused in the frame before until it sh
   };
 
   detail::RefusedEdges refused;
-  const detail::Surgery first = thin(refused);
+  const detail::RepairResult first = thin(refused);
   REQUIRE(first.thin_tried > 0);
   REQUIRE(!refused.empty());
   const long refused_first = static_cast<long>(refused.size());
@@ -59,11 +59,11 @@ TEST_CASE("edits: thinning skips an edge refused in the frame before until it sh
 
   SECTION("the same frame again: none of the refused edges is tried") {
     const detail::RefusedEdges before = refused;
-    const detail::Surgery second = thin(refused);
+    const detail::RepairResult second = thin(refused);
     // An edge is skipped even where a contraction beside it would have let
     // it go later in the pass; so at most the others are tried.
     CHECK(second.thin_tried <= first.thin_tried - refused_first);
-    CHECK(second.contractions > 0);
+    CHECK(second.counts.contractions > 0);
     for (const auto& [edge, memo] : before) {
       const auto carried = refused.find(edge);
       REQUIRE(carried != refused.end());
@@ -80,7 +80,7 @@ TEST_CASE("edits: thinning skips an edge refused in the frame before until it sh
     CHECK(thin(refused).thin_tried == first.thin_tried);
   }
   SECTION("without ids every short edge is tried") {
-    const detail::Surgery plain = detail::mend_by_edits(complex, f.mesh, none_failing, accept, options);
+    const detail::RepairResult plain = detail::mend_by_edits(complex, f.mesh, none_failing, accept, options);
     CHECK(plain.thin_tried == first.thin_tried);
   }
 }
@@ -92,7 +92,7 @@ TEST_CASE("local repair: a patch that would take nearly every vertex is left to 
   auto repair = [&] { return detail::repair_locally(f.complex, f.mesh, all_failing, MeshingOptions{}, f.accept, options); };
   CHECK_FALSE(repair().ok);
   options.policy.max_sample_share = 2;  // no bound: the same patch is meshed
-  const detail::LocalRepair meshed = repair();
+  const detail::RepairResult meshed = repair();
   CHECK(meshed.ok);
-  CHECK(meshed.patch_triangles == static_cast<long>(f.mesh.triangles.size()));
+  CHECK(meshed.counts.patch_triangles == static_cast<long>(f.mesh.triangles.size()));
 }
