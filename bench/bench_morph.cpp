@@ -9,7 +9,9 @@
 //       later frame transported and repaired (morph/morph.hpp);
 //   (c_cmd) the `skinmesh morph --pairs all` command at the same times: the
 //       morph with the command's check of every frame and its output (its
-//       quality columns are what the command's frames.jsonl says).
+//       quality columns are what the command's frames.jsonl says);
+//   (d) the floor: one closed-form transport pass (eq. 19) over the frame
+//       before's vertices into each later frame's complex, no repair.
 // (c) runs every frame; (a) and (b) cost the same at every frame and average
 // a sample spread over (0,1). Quality per column is measured with the clock
 // stopped: every frame graded (closed, manifold, oriented, self-intersections,
@@ -29,9 +31,12 @@
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/morph/alignment.hpp"
 #include "skinmesh/morph/morph.hpp"
+#include "skinmesh/morph/transport.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -114,6 +119,32 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
   return c;
 }
 
+// (d): the floor, one closed-form transport pass (eq. 19, transport.hpp) over
+// the frame before's vertices into each later frame's complex, in parallel as
+// the morph does it; the morph itself makes the frames and complexes, off
+// the clock. No quality of its own (it makes no frame).
+Column run_transport_floor(const Pair& p, int frames) {
+  const std::vector<double> ts = frame_times(frames);
+  Column c;
+  Morph morph = prepare_morph(p.source, p.target, ts.front());
+  c.frames = 1;  // the first frame, as the other columns count it
+  for (size_t k = 1; k < ts.size(); ++k) {
+    const SkinComplex before = morph.complex();
+    const SurfaceMesh mesh = morph.frame().mesh;
+    morph.advance_to(ts[k], k + 1 < ts.size() ? ts[k + 1] : -1);
+    const SkinComplex& after = morph.complex();
+    std::vector<Eigen::Vector3d> moved(mesh.vertices.size());
+    const auto start = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, moved.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t v = r.begin(); v != r.end(); ++v) moved[v] = transport(before, after, mesh.cells[v], mesh.vertices[v]).point;
+    });
+    c.seconds += seconds_since(start);
+    c.frames += 1;
+    c.vertices += static_cast<double>(mesh.vertices.size());
+  }
+  return c;
+}
+
 // (c_cmd): the command's wall time over its frames, into a temporary folder
 // removed after; every frame's quality as its frames.jsonl reports it.
 Column run_command(const Pair& p, int frames) {
@@ -142,8 +173,8 @@ Column run_command(const Pair& p, int frames) {
     c.uncertified += f["oracle_uncertified"].get<double>();
     c.repaired += f["repaired"].get<bool>();
     c.full_rebuilds += f["full_rebuild"].get<bool>();
+    c.remeshed += f["remeshed"].get<bool>();
   }
-  c.remeshed = NAN;  // frames.jsonl of the blend does not say which repairs remeshed the whole frame
   std::filesystem::remove_all(dir);
   if (status != 0 || c.frames != frames) throw std::runtime_error("the command failed: " + command.substr(0, 200));
   return c;
@@ -255,24 +286,33 @@ void print_table(const std::vector<Row>& rows, int timeout) {
       continue;
     }
     const double n = std::max(1.0, c.frames);
+    if (r.column.rfind("d ", 0) == 0) {  // no frames of its own: time only, over the later frames
+      std::printf("| %s | %s | %.0f | %.6f | %.0f | | | | | | | | |\n", r.pair.c_str(), r.column.c_str(), c.frames - 1,
+                  later_ms(c, c.seconds) / 1e3, r.run.peak_mb);
+      continue;
+    }
     std::printf("| %s | %s | %.0f | %.4f | %.0f | %.0f | %.2f | %.3f%% | %.1e | %.0f | %.0f | %.0f | %.0f |\n",
                 r.pair.c_str(), r.column.c_str(), c.frames, c.seconds / n, r.run.peak_mb, c.triangles / n,
                 c.min_angle, 100 * c.below_20 / std::max(1.0, c.triangles), c.max_error, c.invalid_frames,
                 c.repaired, c.remeshed, c.full_rebuilds);
   }
-  std::printf("\n| pair | a/c | b/c | b/c_cmd |\n|---|---|---|---|\n");
+  std::printf("\n| pair | a/c | b/c | b/c_cmd | c_cmd/c | c/d |\n|---|---|---|---|---|---|\n");
   for (size_t i = 0; i < rows.size(); ++i) {
     if (rows[i].column != "c morph") continue;
-    const Row *a = nullptr, *b = nullptr, *cmd = nullptr;
+    const Row *a = nullptr, *b = nullptr, *cmd = nullptr, *d = nullptr;
     for (const Row& r : rows)
       if (r.pair == rows[i].pair) {
         if (r.column.rfind("a ", 0) == 0) a = &r;
         if (r.column.rfind("b ", 0) == 0) b = &r;
         if (r.column.rfind("c_cmd ", 0) == 0) cmd = &r;
+        if (r.column.rfind("d ", 0) == 0) d = &r;
       }
     const double c = per_frame(&rows[i]);
-    std::printf("| %s | %.1f | %.1f | %.1f |\n", rows[i].pair.c_str(), per_frame(a) / c, per_frame(b) / c,
-                per_frame(b) / per_frame(cmd));
+    // c and d per later frame: the first frame is meshed from scratch and has no transport.
+    const double c_later = later_ms(rows[i].run.result, rows[i].run.result.seconds - rows[i].run.result.seconds_first);
+    const double d_later = d && d->run.status == "ok" ? later_ms(d->run.result, d->run.result.seconds) : NAN;
+    std::printf("| %s | %.1f | %.1f | %.1f | %.2f | %.0f |\n", rows[i].pair.c_str(), per_frame(a) / c, per_frame(b) / c,
+                per_frame(b) / per_frame(cmd), per_frame(cmd) / c, c_later / d_later);
   }
   print_stage_table(rows);
 }
@@ -316,6 +356,7 @@ int main(int argc, char** argv) {
     columns.emplace_back("c morph", [&] { return run_morph(p, frames, true); });
     columns.emplace_back("c' morph, whole-frame repairs only", [&] { return run_morph(p, frames, false); });
     columns.emplace_back("c_cmd skinmesh morph --pairs all", [&] { return run_command(p, frames); });
+    columns.emplace_back("d transport pass (floor)", [&] { return run_transport_floor(p, frames); });
     for (const auto& [name, task] : columns) {
       if (!only.empty() && name.find(only) == std::string::npos) continue;
       std::fprintf(stderr, "%s: %s ...\n", p.name.c_str(), name.c_str());
