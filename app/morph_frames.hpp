@@ -128,7 +128,7 @@ struct FrameCounts {
   long frames = 0;
   long from_scratch = 0;  // `full_rebuild`: the first frame, and any later one meshed anew
   long repaired = 0;      // `repaired`
-  long remeshed = 0;      // `remeshed` (moving atoms): remeshed whole from the frame's vertices
+  long remeshed = 0;      // `remeshed`: remeshed whole from the frame's vertices
   long repairs = 0;       // the sum of `repairs` (refinement insertions)
   void add(const nlohmann::json& line);
   std::string text() const;  // "21 frames (1 meshed from scratch, 18 repaired, 2 remeshed whole)"

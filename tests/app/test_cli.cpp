@@ -522,8 +522,9 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
   CHECK(from_scratch >= 1);  // the first frame
   CHECK(m["full_rebuilds"] == from_scratch);
   CHECK(m["repaired_frames"] == repaired);
+  CHECK(m["remeshed_frames"] == remeshed);
   CHECK(r.output.find("4 frames (" + std::to_string(from_scratch) + " meshed from scratch, " + std::to_string(repaired) +
-                      " repaired") != std::string::npos);
+                      " repaired, " + std::to_string(remeshed) + " remeshed whole)") != std::string::npos);
   CHECK(m["frame_times"].size() == 4);
   // The source's balls read back bit for bit from source.xyzr.
   skinmesh::ReadOptions model1;
