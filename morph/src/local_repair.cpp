@@ -375,7 +375,8 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   }
   const PatchMeshResult patch = mesh_patch(complex, samples, roles, repair);
   if (patch.status != MeshingStatus::ok) {  // no faults: growing would not help
-    a.failed_because = std::string("the patch's refinement ended ") + meshing_status_name(patch.status);
+    a.failed_because = std::string("the patch's refinement ended ") + meshing_status_name(patch.status) + " (" +
+                       patch.message + ")";
     return a;
   }
   a.merged.vertices = mesh.vertices;
