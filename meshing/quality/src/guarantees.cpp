@@ -3,8 +3,6 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
@@ -18,29 +16,19 @@ namespace {
 // measured on the complex of the skin's balls built from scratch (the
 // skin function, |F| / |grad F|), which no mesher's state enters either.
 SurfaceError distances(const std::vector<Eigen::Vector3d>& vertices, const SkinReference& skin) {
-  std::vector<double> off(vertices.size());
-  std::vector<char> certified(vertices.size());
   std::optional<SkinOracle> own_oracle;
   if (!skin.oracle) own_oracle.emplace(skin.balls, skin.shrink);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v) {
-      if (skin.oracle) {
-        const SkinDistance d = skin.oracle(vertices[v]);
-        off[v] = d.distance;
-        certified[v] = d.certified;
-      } else {
-        const OracleResult o = own_oracle->evaluate(vertices[v]);
-        off[v] = o.distance();
-        certified[v] = o.certified;
-      }
-    }
-  });
+  const std::vector<SkinDistance> d = oracle_distances(vertices, skin.oracle ? skin.oracle : point_oracle(*own_oracle));
+  std::vector<double> off(d.size());
   SurfaceError e;
-  e.uncertified = std::count(certified.begin(), certified.end(), 0);
+  for (size_t v = 0; v < d.size(); ++v) {
+    off[v] = d[v].distance;
+    e.uncertified += !d[v].certified;
+  }
   if (e.uncertified > 0) {
     const SkinComplex own = build_skin_complex(skin.balls, {skin.shrink});
     for (size_t v = 0; v < off.size(); ++v)
-      if (!certified[v]) {
+      if (!d[v].certified) {
         const SkinEval f = own.evaluate(vertices[v]);
         const double g = f.gradient.norm();
         off[v] = g > 0 ? std::abs(f.value) / g : INFINITY;

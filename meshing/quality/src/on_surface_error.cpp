@@ -5,36 +5,39 @@
 #include "skinmesh/core/skin_oracle.hpp"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 
 namespace skinmesh {
 
+PointOracle point_oracle(const SkinOracle& oracle) {
+  return [&oracle](const Eigen::Vector3d& x) {
+    const OracleResult o = oracle.evaluate(x);
+    return SkinDistance{o.distance(), o.certified};
+  };
+}
+
+std::vector<SkinDistance> oracle_distances(const std::vector<Eigen::Vector3d>& vertices, const PointOracle& oracle) {
+  std::vector<SkinDistance> out(vertices.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) out[v] = oracle(vertices[v]);
+  });
+  return out;
+}
+
 SurfaceError on_surface_error(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
                               double shrink) {
   const SkinOracle oracle(balls, shrink);
-  const SurfaceError total = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, vertices.size(), 1024), SurfaceError{},
-      [&](const tbb::blocked_range<size_t>& range, SurfaceError acc) {
-        for (size_t i = range.begin(); i != range.end(); ++i) {
-          const OracleResult o = oracle.evaluate(vertices[i]);
-          const double d = o.distance();
-          acc.max = std::max(acc.max, d);
-          acc.mean += d;  // a sum until the end
-          acc.uncertified += !o.certified;
-        }
-        return acc;
-      },
-      [](SurfaceError a, const SurfaceError& b) {
-        a.max = std::max(a.max, b.max);
-        a.mean += b.mean;
-        a.uncertified += b.uncertified;
-        return a;
-      });
-  SurfaceError out = total;
-  out.mean = vertices.empty() ? 0.0 : total.mean / static_cast<double>(vertices.size());
-  return out;
+  const std::vector<SkinDistance> d = oracle_distances(vertices, point_oracle(oracle));
+  SurfaceError e;
+  for (const SkinDistance& p : d) {
+    e.max = std::max(e.max, p.distance);
+    e.mean += p.distance;  // a sum until the end
+    e.uncertified += !p.certified;
+  }
+  e.mean = vertices.empty() ? 0.0 : e.mean / static_cast<double>(vertices.size());
+  return e;
 }
 
 }  // namespace skinmesh

@@ -23,13 +23,6 @@
 
 namespace skinmesh {
 
-// A point's distance to the skin by an oracle (Angstrom), and whether the
-// oracle certified it.
-struct SkinDistance {
-  double distance = 0;
-  bool certified = false;
-};
-
 // The skin a mesh claims to approximate, as the check sees it.
 struct SkinReference {
   // Its balls: the topology comes from their alpha complex, and a vertex the
@@ -37,7 +30,7 @@ struct SkinReference {
   std::vector<Ball> balls;
   double shrink = 0.5;
   // The oracle; empty: the static oracle of `balls` (SkinOracle).
-  std::function<SkinDistance(const Eigen::Vector3d&)> oracle;
+  PointOracle oracle;
 };
 
 struct GuaranteeOptions {

@@ -7,16 +7,33 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <vector>
 
 namespace skinmesh {
+
+class SkinOracle;  // skin_oracle.hpp
 
 struct SurfaceError {
   double max = 0.0, mean = 0.0;  // Angstrom: |F(x)| / |grad F(x)| over the vertices
   long uncertified = 0;          // vertices where the oracle could not certify its answer
 };
 
-// In parallel over the vertices.
+// A point's distance to the skin by an oracle (Angstrom), and whether the
+// oracle certified it.
+struct SkinDistance {
+  double distance = 0;
+  bool certified = false;
+};
+using PointOracle = std::function<SkinDistance(const Eigen::Vector3d&)>;
+
+// The static oracle (docs/math.md section 2) as a PointOracle; `oracle` must outlive it.
+PointOracle point_oracle(const SkinOracle& oracle);
+
+// Per vertex, its distance by `oracle`, in parallel over the vertices.
+std::vector<SkinDistance> oracle_distances(const std::vector<Eigen::Vector3d>& vertices, const PointOracle& oracle);
+
+// The static oracle's distances (SkinOracle), summarised; in parallel over the vertices.
 SurfaceError on_surface_error(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
                               double shrink);
 
