@@ -512,7 +512,11 @@ RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given
     std::vector<char> more(region.size(), 0);
     for (int v : a.faults) stars.each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });
     more = grow_region(mesh, stars, std::move(more), 1);
-    for (size_t f = 0; f < region.size(); ++f) region[f] = region[f] || more[f];
+    bool grew = false;
+    for (size_t f = 0; f < region.size(); ++f)
+      if (more[f] && !region[f]) region[f] = grew = true;
+    // The same region would be meshed the same way again.
+    if (!grew) return out;
   }
   return out;
 }

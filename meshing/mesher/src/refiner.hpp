@@ -346,6 +346,7 @@ class Refiner {
   int sample_ids_ = 0;  // ids below this are the given samples' indices (remesh_skin, mesh_patch)
   std::vector<int> star_slot_;  // by vertex id: its place in repair_stars' list, else -1
   std::vector<PatchRole> roles_;  // by sample id (mesh_patch); empty for the whole skin
+  long patch_points_ = 0;         // samples of the patch itself (not its context)
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();
   double expected_vertices_ = 0;

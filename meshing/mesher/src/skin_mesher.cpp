@@ -168,8 +168,9 @@ void Refiner::report(const char* stage, Report when, long pending) {
 }
 
 void Refiner::check_budget() const {
-  // A patch that needs more than twice its own points is not a local repair.
-  if (!roles_.empty() && next_id_ - sample_ids_ > 2 * sample_ids_ + 64)
+  // A patch that needs more than twice its own points (its context not
+  // counted) is not a local repair.
+  if (!roles_.empty() && next_id_ - sample_ids_ > 2 * patch_points_ + 64)
     throw RefinementStopped{MeshingStatus::stalled, "the patch needed more than twice its own points", stats_};
   // A closed surface mesh has about twice as many triangles as vertices.
   const long estimate = 2 * static_cast<long>(dt_.number_of_vertices());
@@ -1035,6 +1036,7 @@ SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
 PatchMeshResult Refiner::run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles) {
   const auto start = Clock::now();
   roles_ = roles;
+  patch_points_ = std::count_if(roles.begin(), roles.end(), [](PatchRole r) { return r != PatchRole::context; });
   insert_samples(samples);
   refine_until_clean();
   PatchMeshResult result;
