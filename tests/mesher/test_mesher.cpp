@@ -404,3 +404,72 @@ TEST_CASE("remesh_skin keeps the given samples, seeds what they miss, and every 
   CHECK(report.quality.components == grade_mesh(first.mesh).components + 1);
   CHECK(report.quality.euler == grade_mesh(first.mesh).euler + 2);
 }
+
+// The cap z > z0 of a sphere's mesh as a patch: cap vertices with a
+// neighbour below z0 are its rim (boundary), the others interior, every other
+// vertex context. Of the interior, only every `keep`-th vertex is given, so
+// refinement has to put the rest back.
+struct CapPatch {
+  std::vector<SkinSample> samples;
+  std::vector<PatchRole> roles;
+  long own = 0, interior_left_out = 0;
+};
+CapPatch cap_patch(const SurfaceMesh& mesh, double z0, size_t keep) {
+  std::vector<char> rim(mesh.vertices.size(), 0);
+  for (const auto& t : mesh.triangles)
+    for (size_t k = 0; k < 3; ++k) {
+      const auto a = static_cast<size_t>(t[k]), b = static_cast<size_t>(t[(k + 1) % 3]);
+      if ((mesh.vertices[a].z() > z0) != (mesh.vertices[b].z() > z0)) rim[a] = rim[b] = 1;
+    }
+  CapPatch p;
+  size_t interior = 0;
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    PatchRole role = PatchRole::context;
+    if (mesh.vertices[v].z() > z0) {
+      role = rim[v] ? PatchRole::boundary : PatchRole::interior;
+      if (role == PatchRole::interior && interior++ % keep != 0) {
+        ++p.interior_left_out;
+        continue;
+      }
+      ++p.own;
+    }
+    p.samples.push_back({mesh.vertices[v], mesh.cells[v]});
+    p.roles.push_back(role);
+  }
+  return p;
+}
+
+TEST_CASE("mesh_patch: a patch that needs more than twice its own points stops, however much context it has",
+          "[mesher][patch]") {
+  // One sphere of skin radius 14 A at edge length 1 A: about 2,900 vertices.
+  const std::vector<Ball> balls{ball(0, 0, 0, 14.0)};
+  const SkinComplex complex = build_skin_complex(balls, {0.5});
+  MeshingOptions options;
+  options.min_angle = 20.0;
+  options.edge_length = 1.0;
+  const SkinMeshResult sphere = mesh_skin(complex, options);
+  REQUIRE(sphere.status == MeshingStatus::ok);
+  // The cap above z = 0, one interior vertex in 20 given: it needs far more
+  // points than twice its own, but fewer than twice its context.
+  const CapPatch sparse = cap_patch(sphere.mesh, 0.0, 20);
+  REQUIRE(sparse.interior_left_out > 2 * sparse.own + 64);
+  REQUIRE(sparse.interior_left_out < 2 * static_cast<long>(sparse.samples.size()));
+  const PatchMeshResult stopped = mesh_patch(complex, sparse.samples, sparse.roles, options);
+  CHECK(stopped.status == MeshingStatus::stalled);
+  CHECK(stopped.message == "the patch needed more than twice its own points");
+  // The same cap with a few of its interior vertices left out is a local
+  // repair: it is meshed, and its triangles lie in the cap.
+  const CapPatch dense = cap_patch(sphere.mesh, 0.0, 1);
+  CapPatch gaps;
+  for (size_t k = 0; k < dense.samples.size(); ++k)
+    if (dense.roles[k] != PatchRole::interior || k % 16 != 0) {
+      gaps.samples.push_back(dense.samples[k]);
+      gaps.roles.push_back(dense.roles[k]);
+    }
+  const PatchMeshResult mended = mesh_patch(complex, gaps.samples, gaps.roles, options);
+  INFO(mended.message);
+  REQUIRE(mended.status == MeshingStatus::ok);
+  CHECK(!mended.added.empty());
+  CHECK(!mended.triangles.empty());
+  for (const SkinSample& p : mended.added) CHECK(p.point.z() > -1.0);
+}
