@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cstdio>
 #include <iterator>
 #include <sstream>
 
@@ -117,4 +118,49 @@ TEST_CASE("written meshes read back with the same vertices and triangles", "[io]
     CHECK(back.vertices[0][0] == static_cast<double>(static_cast<float>(m.vertices[0][0])));
   }
   CHECK_THROWS_AS(mesh_format_from_path("m.xyz"), ContractError);
+}
+
+// Numbers in text formats are written by std::to_chars; they must read as
+// printf's "%.17g" (or "%.9g" in single precision) reads, which is what the
+// formats' earlier stream output was and what the docs promise.
+TEST_CASE("text formats write every real as printf's %.17g (or %.9g) would", "[io]") {
+  SurfaceMesh m = octahedron();
+  const std::vector<double> awkward{0.1, -0.0, 4.9e-324, 1.7976931348623157e308, 123456789.12345679,
+                                    -2.5e-7, 1.0 / 3.0, 1e21, 100.0, -7.0, 1e-5, 0.30000000000000004,
+                                    6.02214076e23, -1.0 / 7.0, 2.0, 1e16, 123.0, 0.5, 5e-324, 42.0};
+  for (size_t k = 0; k < 18; ++k) m.vertices[k / 3][static_cast<long>(k % 3)] = awkward[k];
+  m.normals[0] = {awkward[18], awkward[19], awkward[0]};
+  const auto printf_text = [](double v, int digits) {
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.*g", digits, v);
+    return std::string(text);
+  };
+  for (const bool single : {false, true}) {
+    const int digits = single ? 9 : 17;
+    MeshWriteOptions options;
+    options.single_precision = single;
+    options.ascii = true;
+    for (const MeshFormat format :
+         {MeshFormat::ply, MeshFormat::off, MeshFormat::obj, MeshFormat::vtp, MeshFormat::gmsh, MeshFormat::msms}) {
+      INFO("format " << static_cast<int>(format) << ", digits " << digits);
+      std::ostringstream out;
+      if (format == MeshFormat::msms)
+        write_msms_vert(out, m, nullptr, options);
+      else
+        write_mesh(out, m, format, nullptr, options);
+      const std::string text = out.str();
+      for (const auto& v : m.vertices) {
+        // The vertex's three numbers, one space apart, as printf writes them.
+        const std::string row =
+            printf_text(v[0], digits) + " " + printf_text(v[1], digits) + " " + printf_text(v[2], digits);
+        CHECK(text.find(row) != std::string::npos);
+      }
+      if (format != MeshFormat::off && format != MeshFormat::gmsh) {
+        const Eigen::Vector3d& n = m.normals[0];
+        const std::string row =
+            printf_text(n[0], digits) + " " + printf_text(n[1], digits) + " " + printf_text(n[2], digits);
+        CHECK(text.find(row) != std::string::npos);
+      }
+    }
+  }
 }

@@ -6,15 +6,37 @@
 
 #include <Eigen/Geometry>
 
+#include <charconv>
 #include <cstdint>
 #include <cstring>
-#include <iomanip>
 #include <stdexcept>
 
 namespace skinmesh {
 namespace {
 
 int digits(const MeshWriteOptions& o) { return o.single_precision ? 9 : 17; }
+
+// A real as `out << std::setprecision(digits) << value` writes it (printf's
+// %.*g), formatted by std::to_chars: the stream's own formatting was most
+// of the time of writing a morph's frames.
+struct Real {
+  double value;
+  int digits;
+};
+std::ostream& operator<<(std::ostream& out, Real r) {
+  char text[64];
+  const auto end = std::to_chars(text, text + sizeof(text), r.value, std::chars_format::general, r.digits).ptr;
+  return out.write(text, end - text);
+}
+// An integer as `out << value` writes it.
+struct Integer {
+  long long value;
+};
+std::ostream& operator<<(std::ostream& out, Integer i) {
+  char text[24];
+  const auto end = std::to_chars(text, text + sizeof(text), i.value).ptr;
+  return out.write(text, end - text);
+}
 
 Eigen::Vector3d normal_of(const SurfaceMesh& mesh, size_t v) {
   return v < mesh.normals.size() ? mesh.normals[v] : Eigen::Vector3d::Zero();
@@ -114,6 +136,7 @@ struct BinaryPly {
 
 struct TextPly {
   std::ostream& out;
+  int digits;
   bool first = true;
   void separate() {
     if (!first) out << ' ';
@@ -121,11 +144,11 @@ struct TextPly {
   }
   void real(double v) {
     separate();
-    out << v;
+    out << Real{v, digits};
   }
   void integer(PropertyType, int v) {
     separate();
-    out << v;
+    out << Integer{v};
   }
   void end_line() {
     out << '\n';
@@ -140,8 +163,7 @@ void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
   if (*reinterpret_cast<const uint8_t*>(&probe) != 1) contract_error("the PLY writer needs a little-endian host");
   write_ply_header(out, mesh, attributes, options);
   if (options.ascii) {
-    out << std::setprecision(digits(options));
-    TextPly text{out};
+    TextPly text{out, digits(options)};
     write_ply_body(mesh, attributes, text);
   } else {
     BinaryPly binary{out, options.single_precision};
@@ -150,17 +172,20 @@ void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
 }
 
 void write_off(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
-  out << "OFF\n" << mesh.vertices.size() << " " << mesh.triangles.size() << " 0\n" << std::setprecision(digits(options));
-  for (const auto& v : mesh.vertices) out << v[0] << " " << v[1] << " " << v[2] << "\n";
+  const int d = digits(options);
+  out << "OFF\n" << mesh.vertices.size() << " " << mesh.triangles.size() << " 0\n";
+  for (const auto& v : mesh.vertices) out << Real{v[0], d} << " " << Real{v[1], d} << " " << Real{v[2], d} << "\n";
   for (const auto& t : mesh.triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
 }
 
 void write_obj(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
   const bool normals = mesh.normals.size() == mesh.vertices.size();
-  out << "# skinmesh: molecular skin surface\n" << std::setprecision(digits(options));
-  for (const auto& v : mesh.vertices) out << "v " << v[0] << " " << v[1] << " " << v[2] << "\n";
+  const int d = digits(options);
+  out << "# skinmesh: molecular skin surface\n";
+  for (const auto& v : mesh.vertices) out << "v " << Real{v[0], d} << " " << Real{v[1], d} << " " << Real{v[2], d} << "\n";
   if (normals)
-    for (const auto& n : mesh.normals) out << "vn " << n[0] << " " << n[1] << " " << n[2] << "\n";
+    for (const auto& n : mesh.normals)
+      out << "vn " << Real{n[0], d} << " " << Real{n[1], d} << " " << Real{n[2], d} << "\n";
   for (const auto& t : mesh.triangles) {
     out << "f";
     for (int k = 0; k < 3; ++k) {
@@ -196,16 +221,16 @@ void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
   const char* real = options.single_precision ? "Float32" : "Float64";
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       << "<PolyData>\n<Piece NumberOfPoints=\"" << mesh.vertices.size() << "\" NumberOfPolys=\""
-      << mesh.triangles.size() << "\">\n"
-      << std::setprecision(digits(options));
+      << mesh.triangles.size() << "\">\n";
+  const int d = digits(options);
   out << "<Points>\n<DataArray type=\"" << real << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& v : mesh.vertices) out << v[0] << " " << v[1] << " " << v[2] << "\n";
+  for (const auto& v : mesh.vertices) out << Real{v[0], d} << " " << Real{v[1], d} << " " << Real{v[2], d} << "\n";
   out << "</DataArray>\n</Points>\n<PointData";
   if (mesh.normals.size() == mesh.vertices.size()) out << " Normals=\"Normals\"";
   out << ">\n";
   if (mesh.normals.size() == mesh.vertices.size()) {
     out << "<DataArray type=\"" << real << "\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const auto& n : mesh.normals) out << n[0] << " " << n[1] << " " << n[2] << "\n";
+    for (const auto& n : mesh.normals) out << Real{n[0], d} << " " << Real{n[1], d} << " " << Real{n[2], d} << "\n";
     out << "</DataArray>\n";
   }
   if (has(attributes, mesh)) {
@@ -214,14 +239,14 @@ void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
     columns.insert(columns.end(), attributes->more.begin(), attributes->more.end());
     for (const auto& [name, type, values] : columns) {
       out << "<DataArray type=\"" << vtk_type(type) << "\" Name=\"" << name << "\" format=\"ascii\">\n";
-      for (int v : values) out << v << "\n";
+      for (int v : values) out << Integer{v} << "\n";
       out << "</DataArray>\n";
     }
   }
   out << "</PointData>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& t : mesh.triangles) out << t[0] << " " << t[1] << " " << t[2] << "\n";
+  for (const auto& t : mesh.triangles) out << Integer{t[0]} << " " << Integer{t[1]} << " " << Integer{t[2]} << "\n";
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (size_t i = 0; i < mesh.triangles.size(); ++i) out << 3 * (i + 1) << "\n";
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) out << Integer{3 * static_cast<long long>(i + 1)} << "\n";
   out << "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
 }
 
@@ -232,14 +257,14 @@ void write_gmsh_surface(std::ostream& out, const SurfaceMesh& mesh, const MeshWr
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
   for (const auto& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
   if (mesh.vertices.empty()) lo = hi = Eigen::Vector3d::Zero();
-  out << std::setprecision(digits(options));
+  const int d = digits(options);
   out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"skin\"\n$EndPhysicalNames\n";
-  out << "$Entities\n0 0 1 0\n1 " << lo[0] << ' ' << lo[1] << ' ' << lo[2] << ' ' << hi[0] << ' ' << hi[1] << ' '
-      << hi[2] << " 1 1 0\n$EndEntities\n";
+  out << "$Entities\n0 0 1 0\n1 " << Real{lo[0], d} << ' ' << Real{lo[1], d} << ' ' << Real{lo[2], d} << ' '
+      << Real{hi[0], d} << ' ' << Real{hi[1], d} << ' ' << Real{hi[2], d} << " 1 1 0\n$EndEntities\n";
   const size_t n = mesh.vertices.size(), m = mesh.triangles.size();
   out << "$Nodes\n1 " << n << " 1 " << n << "\n2 1 0 " << n << "\n";
   for (size_t i = 0; i < n; ++i) out << i + 1 << "\n";
-  for (const auto& v : mesh.vertices) out << v[0] << ' ' << v[1] << ' ' << v[2] << "\n";
+  for (const auto& v : mesh.vertices) out << Real{v[0], d} << ' ' << Real{v[1], d} << ' ' << Real{v[2], d} << "\n";
   out << "$EndNodes\n$Elements\n1 " << m << " 1 " << m << "\n2 1 2 " << m << "\n";
   for (size_t i = 0; i < m; ++i) {
     const auto& t = mesh.triangles[i];
@@ -304,14 +329,15 @@ void write_msms_vert(std::ostream& out, const SurfaceMesh& mesh, const VertexAtt
   const bool attrs = has(attributes, mesh);
   out << "# MSMS-format vertices written by skinmesh (molecular skin surface)\n"
       << "#vertex #sphere density probe_r\n"
-      << mesh.vertices.size() << " " << 0 << " " << 0 << " " << 0 << "\n"
-      << std::setprecision(digits(options));
+      << mesh.vertices.size() << " " << 0 << " " << 0 << " " << 0 << "\n";
+  const int d = digits(options);
   // As MSMS writes them: x y z nx ny nz, the analytic face (0: the skin has
   // none numbered), the closest atom (1-based; 0 unknown), the face type.
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Eigen::Vector3d& p = mesh.vertices[v];
     const Eigen::Vector3d n = normal_of(mesh, v);
-    out << p[0] << " " << p[1] << " " << p[2] << " " << n[0] << " " << n[1] << " " << n[2] << " 0 "
+    out << Real{p[0], d} << " " << Real{p[1], d} << " " << Real{p[2], d} << " " << Real{n[0], d} << " "
+        << Real{n[1], d} << " " << Real{n[2], d} << " 0 "
         << (attrs ? attributes->atom[v] + 1 : 0) << " " << msms_face_type(attrs ? attributes->patch[v] : 0) << "\n";
   }
   if (!out) output_error("", "writing the MSMS vertices failed");
