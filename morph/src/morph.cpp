@@ -1,4 +1,6 @@
 #include "skinmesh/morph/morph.hpp"
+#include "skinmesh/core/skin_topology.hpp"
+#include "skinmesh/morph/moving_balls.hpp"  // mesh_topology
 
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"
@@ -125,6 +127,7 @@ struct Morph::Impl {
   // Thinning contractions the edits were refused, kept for the next frame's
   // (detail::RefusedEdges in surgery.hpp).
   std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;
+  std::function<void(SurfaceMesh&, std::vector<long>&)> remesh_fault_;  // detail::inject_remesh_fault
 };
 
 MeshingOptions MorphOptions::repair_criteria() const {
@@ -294,13 +297,35 @@ void Morph::Impl::reseat(const SkinComplex& next, FrameStats& stats) {
 }
 
 // The whole frame remeshed from its transported vertices, or, when the
-// mesher cannot, meshed from scratch (counted as a full rebuild).
+// mesher cannot or the remesh's topology is not the skin's, meshed from
+// scratch (counted as a full rebuild). Either mesh is certified: its
+// components, voids and Euler characteristic must be those of the skin of
+// the frame's balls, counted from their weighted alpha complex
+// (skin_topology.hpp) beside the remesh; a remesh of 1ubi -> 1hpv lost a
+// handle where the complex says one is. Throws Error when the mesh from
+// scratch is not certified either.
 void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
-  if (repair(next, moved, drop)) return;
-  const long before = static_cast<long>(frame_.mesh.vertices.size());
+  SkinTopology skin;
+  tbb::task_group counting;
+  counting.run([&] { skin = skin_topology(next.balls()); });
+  const long before = static_cast<long>(frame_.ids.size());
+  bool remeshed = repair(next, moved, drop);
+  if (remeshed && remesh_fault_) remesh_fault_(frame_.mesh, frame_.ids);
+  counting.wait();
+  if (remeshed) {
+    const SkinTopology made = mesh_topology(frame_.mesh);
+    if (made == skin) return;
+    frame_.stats.remeshed_because += "; the remesh had " + made.text() + " where the skin has " + skin.text() +
+                                     ", so the frame was meshed from scratch";
+  }
   rebuild(next, options_.repair_criteria(), frame_.stats.t);
   frame_.stats.inserted = static_cast<long>(frame_.mesh.vertices.size());
   frame_.stats.removed = before;
+  if (remesh_fault_) remesh_fault_(frame_.mesh, frame_.ids);
+  const SkinTopology made = mesh_topology(frame_.mesh);
+  if (made != skin)
+    throw Error("morph frame at t = " + std::to_string(frame_.stats.t) + ": the mesh has " + made.text() +
+                " where the skin has " + skin.text() + "; the frame is refused");
 }
 
 void Morph::Impl::finish_frame(double t, Clock::time_point start) {
@@ -523,6 +548,14 @@ std::vector<std::array<int, 2>> Morph::Impl::vertex_atoms() const {
   }
   return atoms;
 }
+
+namespace detail {
+
+void inject_remesh_fault(Morph& morph, std::function<void(SurfaceMesh&, std::vector<long>&)> fault) {
+  morph.impl_->remesh_fault_ = std::move(fault);
+}
+
+}  // namespace detail
 
 Morph::Morph(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Morph::Morph(Morph&&) noexcept = default;

@@ -7,7 +7,9 @@
 #include "two_balls.hpp"
 
 #include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/morph/morph.hpp"
+#include "skinmesh/morph/moving_balls.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include <catch2/catch.hpp>
@@ -110,4 +112,59 @@ TEST_CASE("advance_to with the next frame announced makes the same frames, also 
     mended_without_remesh += b.stats.repaired && !b.stats.remeshed;
   }
   CHECK(mended_without_remesh > 0);  // the moving ahead overlapped edits or a patch
+}
+
+// A closed tetrahedron 100 A away from everything, outward, with new ids:
+// one component more than the skin has.
+void add_a_component(SurfaceMesh& mesh, std::vector<long>& ids) {
+  const int n = static_cast<int>(mesh.vertices.size());
+  const Eigen::Vector3d c(100, 0, 0);
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1), Eigen::Vector3d(-1, 1, -1),
+                                   Eigen::Vector3d(-1, -1, 1)}) {
+    mesh.vertices.push_back(c + d);
+    mesh.normals.push_back(d.normalized());
+    mesh.cells.push_back(mesh.cells.front());
+    ids.push_back(-1 - static_cast<long>(ids.size()));
+  }
+  for (const std::array<int, 3>& t : {std::array<int, 3>{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}})
+    mesh.triangles.push_back({n + t[0], n + t[1], n + t[2]});
+}
+
+TEST_CASE("a blend frame remeshed whole is certified against the skin's topology", "[morph][topology]") {
+  const test::TwoBallMorph two;
+  MorphOptions options;  // every repair a whole-frame remesh
+  options.repair.patch.max_failing_share = 0;
+  options.repair.edits.enabled = false;
+  Morph morph = prepare_morph(two.source, two.target, 0.05, options);
+  int faults = 0;
+  // The first frame remeshed whole: with the fault once, its remesh (one
+  // component too many) is meshed again from scratch; with the fault always,
+  // the frame is refused.
+  const auto first_remeshed = [&]() -> const MorphFrame* {
+    for (double t = 0.1; t < 0.96; t += 0.05) {
+      const MorphFrame& f = morph.advance_to(t);
+      if (faults > 0) return &f;
+    }
+    return nullptr;
+  };
+  SECTION("a remesh with a component the skin lacks is meshed from scratch") {
+    detail::inject_remesh_fault(morph, [&](SurfaceMesh& mesh, std::vector<long>& ids) {
+      if (faults++ == 0) add_a_component(mesh, ids);
+    });
+    const MorphFrame* f = first_remeshed();
+    REQUIRE(f != nullptr);
+    CHECK(faults == 2);  // the remesh, then the mesh from scratch
+    CHECK(mesh_topology(f->mesh) == skin_topology(morph.complex().balls()));
+    CHECK(f->stats.full_rebuild);
+    CHECK(f->stats.remeshed_because.find("so the frame was meshed from scratch") != std::string::npos);
+    CHECK(f->ids.size() == f->mesh.vertices.size());
+  }
+  SECTION("a frame whose mesh from scratch is wrong too is refused") {
+    detail::inject_remesh_fault(morph, [&](SurfaceMesh& mesh, std::vector<long>& ids) {
+      ++faults;
+      add_a_component(mesh, ids);
+    });
+    CHECK_THROWS_WITH(first_remeshed(), Catch::Contains("the frame is refused"));
+    CHECK(faults == 2);
+  }
 }

@@ -28,6 +28,14 @@ std::ostream& operator<<(std::ostream& out, Real r) {
   const auto end = std::to_chars(text, text + sizeof(text), r.value, std::chars_format::general, r.digits).ptr;
   return out.write(text, end - text);
 }
+// A point or normal as its three Reals, one space apart.
+struct Reals3 {
+  const Eigen::Vector3d& value;
+  int digits;
+};
+std::ostream& operator<<(std::ostream& out, Reals3 r) {
+  return out << Real{r.value[0], r.digits} << ' ' << Real{r.value[1], r.digits} << ' ' << Real{r.value[2], r.digits};
+}
 // An integer as `out << value` writes it.
 struct Integer {
   long long value;
@@ -174,7 +182,7 @@ void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
 void write_off(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
   const int d = digits(options);
   out << "OFF\n" << mesh.vertices.size() << " " << mesh.triangles.size() << " 0\n";
-  for (const auto& v : mesh.vertices) out << Real{v[0], d} << " " << Real{v[1], d} << " " << Real{v[2], d} << "\n";
+  for (const auto& v : mesh.vertices) out << Reals3{v, d} << "\n";
   for (const auto& t : mesh.triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
 }
 
@@ -182,10 +190,9 @@ void write_obj(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOption
   const bool normals = mesh.normals.size() == mesh.vertices.size();
   const int d = digits(options);
   out << "# skinmesh: molecular skin surface\n";
-  for (const auto& v : mesh.vertices) out << "v " << Real{v[0], d} << " " << Real{v[1], d} << " " << Real{v[2], d} << "\n";
+  for (const auto& v : mesh.vertices) out << "v " << Reals3{v, d} << "\n";
   if (normals)
-    for (const auto& n : mesh.normals)
-      out << "vn " << Real{n[0], d} << " " << Real{n[1], d} << " " << Real{n[2], d} << "\n";
+    for (const auto& n : mesh.normals) out << "vn " << Reals3{n, d} << "\n";
   for (const auto& t : mesh.triangles) {
     out << "f";
     for (int k = 0; k < 3; ++k) {
@@ -224,13 +231,13 @@ void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
       << mesh.triangles.size() << "\">\n";
   const int d = digits(options);
   out << "<Points>\n<DataArray type=\"" << real << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& v : mesh.vertices) out << Real{v[0], d} << " " << Real{v[1], d} << " " << Real{v[2], d} << "\n";
+  for (const auto& v : mesh.vertices) out << Reals3{v, d} << "\n";
   out << "</DataArray>\n</Points>\n<PointData";
   if (mesh.normals.size() == mesh.vertices.size()) out << " Normals=\"Normals\"";
   out << ">\n";
   if (mesh.normals.size() == mesh.vertices.size()) {
     out << "<DataArray type=\"" << real << "\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const auto& n : mesh.normals) out << Real{n[0], d} << " " << Real{n[1], d} << " " << Real{n[2], d} << "\n";
+    for (const auto& n : mesh.normals) out << Reals3{n, d} << "\n";
     out << "</DataArray>\n";
   }
   if (has(attributes, mesh)) {
@@ -259,12 +266,11 @@ void write_gmsh_surface(std::ostream& out, const SurfaceMesh& mesh, const MeshWr
   if (mesh.vertices.empty()) lo = hi = Eigen::Vector3d::Zero();
   const int d = digits(options);
   out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"skin\"\n$EndPhysicalNames\n";
-  out << "$Entities\n0 0 1 0\n1 " << Real{lo[0], d} << ' ' << Real{lo[1], d} << ' ' << Real{lo[2], d} << ' '
-      << Real{hi[0], d} << ' ' << Real{hi[1], d} << ' ' << Real{hi[2], d} << " 1 1 0\n$EndEntities\n";
+  out << "$Entities\n0 0 1 0\n1 " << Reals3{lo, d} << ' ' << Reals3{hi, d} << " 1 1 0\n$EndEntities\n";
   const size_t n = mesh.vertices.size(), m = mesh.triangles.size();
   out << "$Nodes\n1 " << n << " 1 " << n << "\n2 1 0 " << n << "\n";
   for (size_t i = 0; i < n; ++i) out << i + 1 << "\n";
-  for (const auto& v : mesh.vertices) out << Real{v[0], d} << ' ' << Real{v[1], d} << ' ' << Real{v[2], d} << "\n";
+  for (const auto& v : mesh.vertices) out << Reals3{v, d} << "\n";
   out << "$EndNodes\n$Elements\n1 " << m << " 1 " << m << "\n2 1 2 " << m << "\n";
   for (size_t i = 0; i < m; ++i) {
     const auto& t = mesh.triangles[i];
@@ -336,8 +342,7 @@ void write_msms_vert(std::ostream& out, const SurfaceMesh& mesh, const VertexAtt
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Eigen::Vector3d& p = mesh.vertices[v];
     const Eigen::Vector3d n = normal_of(mesh, v);
-    out << Real{p[0], d} << " " << Real{p[1], d} << " " << Real{p[2], d} << " " << Real{n[0], d} << " "
-        << Real{n[1], d} << " " << Real{n[2], d} << " 0 "
+    out << Reals3{p, d} << " " << Reals3{n, d} << " 0 "
         << (attrs ? attributes->atom[v] + 1 : 0) << " " << msms_face_type(attrs ? attributes->patch[v] : 0) << "\n";
   }
   if (!out) output_error("", "writing the MSMS vertices failed");

@@ -40,6 +40,7 @@
 #include "skinmesh/morph/repair_policy.hpp"
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -133,6 +134,14 @@ struct MorphFrame {
   FrameStats stats;
 };
 
+class Morph;
+namespace detail {
+// For tests only: `fault` is applied to every mesh of a frame remeshed
+// whole or meshed from scratch after a remesh, with the frame's ids, just
+// before its topology certificate.
+void inject_remesh_fault(Morph& morph, std::function<void(SurfaceMesh&, std::vector<long>&)> fault);
+}  // namespace detail
+
 class Morph {
  public:
   // Moves the mesh to frame t, later than the current one and at most 1.
@@ -171,6 +180,7 @@ class Morph {
   friend Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0,
                              const MorphOptions& options);
   std::unique_ptr<Impl> impl_;
+  friend void detail::inject_remesh_fault(Morph&, std::function<void(SurfaceMesh&, std::vector<long>&)>);
 };
 
 // Live pairs, the complex of B(1/2), the topology events, and the first
