@@ -301,15 +301,15 @@ void Morph::Impl::reseat(const SkinComplex& next, FrameStats& stats) {
 // scratch (counted as a full rebuild). Either mesh is certified: its
 // components, voids and Euler characteristic must be those of the skin of
 // the frame's balls, counted from their weighted alpha complex
-// (skin_topology.hpp) beside the remesh; a remesh of 1ubi -> 1hpv lost a
-// handle where the complex says one is. Throws Error when the mesh from
-// scratch is not certified either.
+// (skin_topology.hpp) beside the remesh: refinement from transported
+// vertices can close a thin handle that seeds and refinement from scratch
+// keep. Throws Error when the mesh from scratch is not certified either.
 void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
   SkinTopology skin;
   tbb::task_group counting;
   counting.run([&] { skin = skin_topology(next.balls()); });
   const long before = static_cast<long>(frame_.ids.size());
-  bool remeshed = repair(next, moved, drop);
+  const bool remeshed = repair(next, moved, drop);
   if (remeshed && remesh_fault_) remesh_fault_(frame_.mesh, frame_.ids);
   counting.wait();
   if (remeshed) {
