@@ -361,8 +361,7 @@ MovingOptions moving_options(const MorphOptions& m) {
   o.frames = m.frames;
   o.first_size_margin = m.first_size_margin;
   o.relaxation = m.relaxation;
-  o.repair = m.repair;
-  return o;
+  return o;  // the repair policy stays the moving engine's own (moving_balls.hpp)
 }
 
 // --pairs matched: the atoms travel (matched_motion.hpp), carried by the

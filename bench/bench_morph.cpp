@@ -19,7 +19,8 @@
 // section 4), which knows neither the complex nor the live pairs.
 //
 //   bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [--only TEXT] [PAIR...]
-//   (--only: run the columns whose name contains TEXT)
+//   (--only: run the columns whose name contains TEXT, or one of the
+//   comma-separated TEXTs: --only "b skin,c morph,c_cmd")
 //   PAIR: SOURCE:TARGET, a file optionally followed by #MODEL
 //   (default: pept:3al1, 3al1:1ubi, 1ubi:1hpv, 2k39_3models#1:#3 from data/)
 #include "cgal_reference.hpp"
@@ -317,6 +318,18 @@ void print_table(const std::vector<Row>& rows, int timeout) {
   print_stage_table(rows);
 }
 
+// Whether `name` contains one of the comma-separated texts of `list`.
+bool names_any(const std::string& name, const std::string& list) {
+  size_t from = 0;
+  while (from <= list.size()) {
+    const size_t comma = std::min(list.find(',', from), list.size());
+    const std::string text = list.substr(from, comma - from);
+    if (!text.empty() && name.find(text) != std::string::npos) return true;
+    from = comma + 1;
+  }
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -358,7 +371,7 @@ int main(int argc, char** argv) {
     columns.emplace_back("c_cmd skinmesh morph --pairs all", [&] { return run_command(p, frames); });
     columns.emplace_back("d transport pass (floor)", [&] { return run_transport_floor(p, frames); });
     for (const auto& [name, task] : columns) {
-      if (!only.empty() && name.find(only) == std::string::npos) continue;
+      if (!only.empty() && !names_any(name, only)) continue;
       std::fprintf(stderr, "%s: %s ...\n", p.name.c_str(), name.c_str());
       Row row{p.name, name, bench::run_forked<Column>(timeout, task)};
       print_json(row, p);

@@ -69,7 +69,17 @@ struct MovingOptions {
   // that moved farther (it jumped to another piece of skin) takes a new id.
   double continuity = 1.0;  // dimensionless
   RelaxationOptions relaxation;  // for the corners of failing triangles
-  RepairPolicy repair;           // every threshold of the repair (repair_policy.hpp)
+  // Every threshold of the repair (repair_policy.hpp), as the blend's but
+  // for the largest patch: a third of the frame's vertices (with the
+  // patch's context), not 0.9. Moving atoms fail triangles in many places
+  // at once (thermal motion: all over the surface), and a patch past a
+  // third of the frame cost more than remeshing the frame whole, whether it
+  // succeeded or not (docs/benchmarks.md, moving atoms).
+  RepairPolicy repair = [] {
+    RepairPolicy r;
+    r.patch.max_sample_share = 0.3;  // a share, 0-1
+    return r;
+  }();
 };
 
 class MovingBalls {

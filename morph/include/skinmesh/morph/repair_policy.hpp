@@ -55,8 +55,9 @@ struct PatchPolicy {
   // A patch whose samples (with their context) pass this share of the
   // frame's vertices is not tried (a share, 0-1): it is nearly the whole
   // frame, which the whole-frame remesh does once, where a patch may be
-  // tried `attempts` times. Lower would also refuse patches of a third to a
-  // half of the frame, which often succeed cheaply.
+  // tried `attempts` times. For the blend, lower would also refuse patches
+  // of a third to a half of the frame, which often succeed cheaply there;
+  // moving atoms take 0.3 (moving_balls.hpp).
   double max_sample_share = 0.9;
 };
 
