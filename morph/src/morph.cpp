@@ -41,28 +41,32 @@ bool takes_a_sphere(const TopologyEvent& e) { return (e.dim == 0 || e.dim == 3) 
 // up to. A component or a void born (dimension 0 or 3, the Euler
 // characteristic up by 2) is seeded around its centre. One that vanishes
 // (down by 2) and was `handled` (its component dropped, drop_vanished) is
-// left out. False when one vanishes that was not: the frame is remeshed
-// whole. (Such an event as a patch to remesh, like a neck, made the morph
-// slower, the patches failing after their cost.) The patch reaches 1 A plus
-// twice the feature's size at `to` from the event's apex, past the vertices
-// transport left around it.
+// left out; one that cancels an event of the same step
+// (cancelling_partners) is a place with its partner, adding nothing to the
+// Euler characteristic. False when one vanishes that was neither: the
+// frame is remeshed whole. (Such an event as a patch to remesh, like a
+// neck, made the morph slower, the patches failing after their cost.) The
+// patch reaches 1 A plus twice the feature's size at `to` from the event's
+// apex, past the vertices transport left around it.
 bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
                           double to, const std::vector<char>& handled, detail::LocalRepairOptions& local) {
+  const std::vector<int> partner = cancelling_partners(events, sizes, from, to, handled);  // a void within the step
   for (size_t i = 0; i < events.size(); ++i) {
     const TopologyEvent& e = events[i];
     if (!in_step(e, from, to) || handled[i]) continue;
-    if (takes_a_sphere(e)) return false;
+    const bool cancelled = partner[i] >= 0;
+    if (takes_a_sphere(e) && !cancelled) return false;
     const bool sphere = e.dim == 0 || e.dim == 3;
     const CellSize& size = sizes[static_cast<size_t>(e.cell)];
     const double feature = std::sqrt(std::abs(size.at(to)));
     detail::TopologyChange change;
     change.point = size.center(to);
     change.radius = 1.0 + 2 * feature;
-    change.birth = sphere && e.euler_change > 0;
+    change.birth = sphere && e.euler_change > 0 && !cancelled;
     change.size = feature;
     change.cell = e.cell;
     local.changes.push_back(change);
-    local.euler_change += e.euler_change;
+    if (!cancelled) local.euler_change += e.euler_change;
   }
   return true;
 }
@@ -386,11 +390,13 @@ std::vector<char> Morph::Impl::drop_vanished(double t, const std::vector<char>& 
 }
 
 // Whether a component or void vanishes in (t_, t] that drop_vanished did
-// not drop (`handled`): the frame is then remeshed whole.
+// not drop (`handled`) and that was not born in the step itself
+// (cancelling_partners): the frame is then remeshed whole.
 bool Morph::Impl::vanishing_left(double t, const std::vector<char>& handled) const {
+  const std::vector<int> partner = cancelling_partners(events_, sizes_, t_, t, handled);
   for (size_t i = 0; i < events_.size(); ++i) {
     const TopologyEvent& e = events_[i];
-    if (in_step(e, t_, t) && takes_a_sphere(e) && !handled[i]) return true;
+    if (in_step(e, t_, t) && takes_a_sphere(e) && !handled[i] && partner[i] < 0) return true;
   }
   return false;
 }

@@ -7,6 +7,7 @@
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/morph/alignment.hpp"
 #include "skinmesh/morph/events.hpp"
 
@@ -62,6 +63,79 @@ TEST_CASE("the event where two skins join is found ahead of time", "[morph][even
   CHECK(critical.front().t == first);
   CHECK_FALSE(joined(first - 1e-3));
   CHECK(joined(first + 1e-3));
+}
+
+TEST_CASE("cancelling events: a void sealed and filled in one step pairs, nothing else does", "[morph][events]") {
+  // Cells 0 and 1 at one place, cell 2 two A away.
+  std::vector<CellSize> sizes(3);
+  sizes[1].center_half = Eigen::Vector3d(0.1, 0, 0);
+  sizes[2].center_half = Eigen::Vector3d(2, 0, 0);
+  const auto event = [](double t, int cell, int dim, int euler) {
+    TopologyEvent e;
+    e.t = t;
+    e.cell = cell;
+    e.dim = dim;
+    e.euler_change = euler;
+    return e;
+  };
+  const auto partners = [&](const std::vector<TopologyEvent>& events, std::vector<char> skip = {}) {
+    if (skip.empty()) skip.assign(events.size(), 0);
+    return cancelling_partners(events, sizes, 0.3, 0.4, skip);
+  };
+  const TopologyEvent sealed = event(0.32, 0, 2, +2), filled = event(0.35, 1, 3, -2);
+  CHECK(partners({sealed, filled}) == std::vector<int>{1, 0});
+  CHECK(partners({event(0.32, 0, 1, +2), event(0.35, 1, 0, -2)}) == std::vector<int>{1, 0});  // a piece pinched off, gone
+  CHECK(partners({event(0.36, 0, 2, +2), filled}) == std::vector<int>{-1, -1});  // filled before sealed: another void
+  CHECK(partners({sealed, event(0.35, 2, 3, -2)}) == std::vector<int>{-1, -1});  // two A apart
+  CHECK(partners({event(0.25, 0, 2, +2), filled}) == std::vector<int>{-1, -1});  // sealed in the step before
+  CHECK(partners({event(0.32, 0, 1, +2), filled}) == std::vector<int>{-1, -1});  // a neck, not a seal
+  CHECK(partners({sealed, filled}, {0, 1}) == std::vector<int>{-1, -1});        // the filling accounted for
+  // Two seals and one filling: the filling takes the nearer seal, once.
+  std::vector<TopologyEvent> three{event(0.31, 2, 2, +2), sealed, filled};
+  sizes[2].center_half = Eigen::Vector3d(0.3, 0, 0);
+  CHECK(partners(three) == std::vector<int>{-1, 2, 1});
+  CHECK_THROWS_AS(cancelling_partners(three, sizes, 0.3, 0.4, {0}), ContractError);
+}
+
+TEST_CASE("cancelling events of pept -> 3al1 are voids the alpha complex sees only inside the step",
+          "[morph][events]") {
+  // Independent of the events' bookkeeping: the skin's topology counted
+  // from B(t)'s alpha complex (skin_topology) before, between and after
+  // every pair that no other event interleaves.
+  const std::vector<Ball> source = test::centred_model(test::data_file("pept.pdb"), 1);
+  const std::vector<Ball> target = test::centred_model(test::data_file("3al1.pdb"), 1);
+  const auto live = live_pairs(source, target);
+  const SkinComplex middle = build_skin_complex(interpolated_balls(source, target, live, 0.5), {0.5});
+  const std::vector<CellSize> sizes = cell_sizes(middle, source, target, live);
+  const MorphOracle oracle(source, target, 0.5);
+  const std::vector<TopologyEvent> events =
+      critical_events(topology_events(sizes), sizes, middle, live, oracle);
+  const auto topology_at = [&](double t) { return skin_topology(interpolated_balls(source, target, live, t)); };
+  long pairs = 0, isolated = 0;
+  for (int k = 0; k < 100; ++k) {
+    const double from = k / 100.0, to = (k + 1) / 100.0;
+    const std::vector<int> partner = cancelling_partners(events, sizes, from, to, std::vector<char>(events.size(), 0));
+    for (size_t i = 0; i < events.size(); ++i) {
+      if (partner[i] < 0 || events[i].euler_change > 0) continue;  // each pair once, by its vanishing event
+      ++pairs;
+      const TopologyEvent& made = events[static_cast<size_t>(partner[i])];
+      const TopologyEvent& gone = events[i];
+      const double margin = 1e-6;
+      const bool alone = std::none_of(events.begin(), events.end(), [&](const TopologyEvent& e) {
+        return &e != &made && &e != &gone && e.t > made.t - margin && e.t < gone.t + margin;
+      });
+      if (!alone || gone.t - made.t < 4 * margin) continue;
+      ++isolated;
+      const SkinTopology before = topology_at(made.t - margin), inside = topology_at((made.t + gone.t) / 2),
+                         after = topology_at(gone.t + margin);
+      INFO("pair at t = " << made.t << " .. " << gone.t << ", dimensions " << made.dim << ", " << gone.dim);
+      CHECK(before == after);
+      CHECK(inside.components == before.components + 1);
+      CHECK(inside.voids == before.voids + (gone.dim == 3 ? 1 : 0));
+    }
+  }
+  INFO(pairs << " cancelling pairs in 100 steps, " << isolated << " with no other event between them");
+  CHECK(isolated >= 3);  // premise: the morph has such voids
 }
 
 TEST_CASE("alignment: Kabsch recovers a rigid motion, centroid otherwise", "[morph][alignment]") {

@@ -60,4 +60,16 @@ std::vector<TopologyEvent> critical_events(const std::vector<TopologyEvent>& eve
                                            const std::vector<CellSize>& sizes, const SkinComplex& middle,
                                            const std::vector<BallPair>& pairs, const MorphOracle& oracle);
 
+// Per critical event, the event it cancels within the step (from, to], or
+// -1: a void sealed (dimension 2, Euler characteristic +2) and filled
+// (dimension 3, -2), or a piece pinched off a component (dimension 1, +2)
+// that then vanishes (dimension 0, -2), the vanishing second and its apex
+// within `same_place` of the first's (Angstrom, each at its own time). The
+// void or piece lives inside the step only: no frame holds it, and the two
+// change no topology. Vanishing events marked in `skip` (accounted for
+// otherwise) are not paired.
+std::vector<int> cancelling_partners(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes,
+                                     double from, double to, const std::vector<char>& skip,
+                                     double same_place = 0.5);
+
 }  // namespace skinmesh
