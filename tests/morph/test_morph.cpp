@@ -6,6 +6,7 @@
 #include "test_support.hpp"
 #include "two_balls.hpp"
 
+#include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/morph/morph.hpp"
@@ -112,6 +113,40 @@ TEST_CASE("advance_to with the next frame announced makes the same frames, also 
     mended_without_remesh += b.stats.repaired && !b.stats.remeshed;
   }
   CHECK(mended_without_remesh > 0);  // the moving ahead overlapped edits or a patch
+}
+
+TEST_CASE("a void sealed and filled within one step is mended locally, with the skin's topology", "[morph][events]") {
+  const auto source = test::centred_model(test::data_file("pept.pdb"), 1);
+  const auto target = test::centred_model(test::data_file("3al1.pdb"), 1);
+  const auto live = live_pairs(source, target);
+  const SkinComplex middle = build_skin_complex(interpolated_balls(source, target, live, 0.5), {0.5});
+  const std::vector<CellSize> sizes = cell_sizes(middle, source, target, live);
+  const std::vector<TopologyEvent> events =
+      critical_events(topology_events(sizes), sizes, middle, live, MorphOracle(source, target, 0.5));
+  // Steps just around a pair (cancelling_partners) with no other event near.
+  constexpr double kMargin = 1e-4;
+  std::vector<std::pair<double, double>> steps;
+  for (int k = 0; k < 100 && steps.size() < 3; ++k) {
+    const std::vector<int> partner =
+        cancelling_partners(events, sizes, k / 100.0, (k + 1) / 100.0, std::vector<char>(events.size(), 0));
+    for (size_t i = 0; i < events.size() && steps.size() < 3; ++i) {
+      if (partner[i] < 0 || events[i].dim != 3) continue;
+      const double from = events[static_cast<size_t>(partner[i])].t - kMargin, to = events[i].t + kMargin;
+      const long near = std::count_if(events.begin(), events.end(), [&](const TopologyEvent& e) {
+        return e.t > from - kMargin && e.t <= to + kMargin;
+      });
+      if (near == 2) steps.emplace_back(from, to);
+    }
+  }
+  REQUIRE(steps.size() >= 2);  // premise: pept -> 3al1 has such voids
+  for (const auto& [from, to] : steps) {
+    INFO("step " << from << " .. " << to);
+    Morph morph = prepare_morph(source, target, from);
+    const MorphFrame& f = morph.advance_to(to);
+    CHECK(f.stats.events == 2);
+    CHECK(f.stats.remeshed_because.find("vanished") == std::string::npos);
+    CHECK(mesh_topology(f.mesh) == skin_topology(interpolated_balls(source, target, live, to)));
+  }
 }
 
 // A closed tetrahedron 100 A away from everything, outward, with new ids:
