@@ -1,6 +1,7 @@
 // Topology events ahead of time (eq. 18: every cell's size is quadratic in t)
 // and the alignment of a target onto its source.
 #include "test_support.hpp"
+#include "blend_events.hpp"
 #include "two_balls.hpp"
 
 #include "skinmesh/core/error.hpp"
@@ -20,9 +21,10 @@ using namespace skinmesh;
 TEST_CASE("every overlay cell's size is the quadratic fitted at three frames", "[morph][events]") {
   const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
   const auto m2 = test::centred_model(test::data_file("2k39_3models.pdb"), 2);
-  const auto live = live_pairs(m1, m2);
-  const SkinComplex middle = build_skin_complex(interpolated_balls(m1, m2, live, 0.5), {0.5});
-  const std::vector<CellSize> sizes = cell_sizes(middle, m1, m2, live);
+  const test::BlendEvents blend(m1, m2);
+  const auto& live = blend.live;
+  const SkinComplex& middle = blend.middle;
+  const std::vector<CellSize>& sizes = blend.sizes;
   REQUIRE(sizes.size() == middle.cells().size());
   long off = 0, checked = 0, other = 0;
   for (double t : {0.1, 0.4, 0.9}) {
@@ -104,12 +106,10 @@ TEST_CASE("cancelling events of pept -> 3al1 are voids the alpha complex sees on
   // every pair that no other event interleaves.
   const std::vector<Ball> source = test::centred_model(test::data_file("pept.pdb"), 1);
   const std::vector<Ball> target = test::centred_model(test::data_file("3al1.pdb"), 1);
-  const auto live = live_pairs(source, target);
-  const SkinComplex middle = build_skin_complex(interpolated_balls(source, target, live, 0.5), {0.5});
-  const std::vector<CellSize> sizes = cell_sizes(middle, source, target, live);
-  const MorphOracle oracle(source, target, 0.5);
-  const std::vector<TopologyEvent> events =
-      critical_events(topology_events(sizes), sizes, middle, live, oracle);
+  test::BlendEvents blend(source, target);
+  const std::vector<TopologyEvent>& events = blend.with_critical(source, target).critical;
+  const std::vector<CellSize>& sizes = blend.sizes;
+  const auto& live = blend.live;
   const auto topology_at = [&](double t) { return skin_topology(interpolated_balls(source, target, live, t)); };
   long pairs = 0, isolated = 0;
   for (int k = 0; k < 100; ++k) {

@@ -4,6 +4,7 @@
 // angle bound and the grader; ids kept by surviving vertices and never
 // reused. The acceptance tests on real pairs: test_morph_pairs.cpp.
 #include "test_support.hpp"
+#include "blend_events.hpp"
 #include "two_balls.hpp"
 
 #include "skinmesh/core/interpolation.hpp"
@@ -118,11 +119,9 @@ TEST_CASE("advance_to with the next frame announced makes the same frames, also 
 TEST_CASE("a void sealed and filled within one step is mended locally, with the skin's topology", "[morph][events]") {
   const auto source = test::centred_model(test::data_file("pept.pdb"), 1);
   const auto target = test::centred_model(test::data_file("3al1.pdb"), 1);
-  const auto live = live_pairs(source, target);
-  const SkinComplex middle = build_skin_complex(interpolated_balls(source, target, live, 0.5), {0.5});
-  const std::vector<CellSize> sizes = cell_sizes(middle, source, target, live);
-  const std::vector<TopologyEvent> events =
-      critical_events(topology_events(sizes), sizes, middle, live, MorphOracle(source, target, 0.5));
+  test::BlendEvents blend(source, target);
+  const std::vector<TopologyEvent>& events = blend.with_critical(source, target).critical;
+  const std::vector<CellSize>& sizes = blend.sizes;
   // Steps just around a pair (cancelling_partners) with no other event near.
   constexpr double kMargin = 1e-4;
   std::vector<std::pair<double, double>> steps;
@@ -145,7 +144,7 @@ TEST_CASE("a void sealed and filled within one step is mended locally, with the 
     const MorphFrame& f = morph.advance_to(to);
     CHECK(f.stats.events == 2);
     CHECK(f.stats.remeshed_because.find("vanished") == std::string::npos);
-    CHECK(mesh_topology(f.mesh) == skin_topology(interpolated_balls(source, target, live, to)));
+    CHECK(mesh_topology(f.mesh) == skin_topology(interpolated_balls(source, target, blend.live, to)));
   }
 }
 
