@@ -115,18 +115,20 @@ std::vector<TopologyEvent> critical_events(const std::vector<TopologyEvent>& eve
 std::vector<int> cancelling_partners(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes,
                                      double from, double to, const std::vector<char>& skip, double same_place) {
   if (skip.size() != events.size()) contract_error("cancelling_partners: one skip mark per event");
-  const auto in_step = [&](const TopologyEvent& e) { return e.t > from && e.t <= to; };
+  std::vector<size_t> step;  // the events in (from, to]: a few of the morph's thousands
+  for (size_t i = 0; i < events.size(); ++i)
+    if (events[i].t > from && events[i].t <= to) step.push_back(i);
   const auto apex = [&](const TopologyEvent& e) { return sizes[static_cast<size_t>(e.cell)].center(e.t); };
   std::vector<int> partner(events.size(), -1);
-  for (size_t i = 0; i < events.size(); ++i) {
+  for (size_t i : step) {
     const TopologyEvent& gone = events[i];
     const bool vanishing = (gone.dim == 0 || gone.dim == 3) && gone.euler_change < 0;
-    if (!in_step(gone) || skip[i] || !vanishing) continue;
+    if (skip[i] || !vanishing) continue;
     const int opening_dim = gone.dim == 3 ? 2 : 1;
     double nearest = same_place;
-    for (size_t j = 0; j < events.size(); ++j) {
+    for (size_t j : step) {
       const TopologyEvent& made = events[j];
-      if (j == i || partner[j] >= 0 || !in_step(made) || made.t > gone.t || made.dim != opening_dim ||
+      if (j == i || partner[j] >= 0 || made.t > gone.t || made.dim != opening_dim ||
           made.euler_change != -gone.euler_change)
         continue;
       const double d = (apex(made) - apex(gone)).norm();

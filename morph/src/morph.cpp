@@ -41,16 +41,16 @@ bool takes_a_sphere(const TopologyEvent& e) { return (e.dim == 0 || e.dim == 3) 
 // up to. A component or a void born (dimension 0 or 3, the Euler
 // characteristic up by 2) is seeded around its centre. One that vanishes
 // (down by 2) and was `handled` (its component dropped, drop_vanished) is
-// left out; one that cancels an event of the same step
-// (cancelling_partners) is a place with its partner, adding nothing to the
+// left out; one that cancels an event of the same step (`partner`,
+// cancelling_partners) is a place with its partner, adding nothing to the
 // Euler characteristic. False when one vanishes that was neither: the
 // frame is remeshed whole. (Such an event as a patch to remesh, like a
 // neck, made the morph slower, the patches failing after their cost.) The
 // patch reaches 1 A plus twice the feature's size at `to` from the event's
 // apex, past the vertices transport left around it.
 bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
-                          double to, const std::vector<char>& handled, detail::LocalRepairOptions& local) {
-  const std::vector<int> partner = cancelling_partners(events, sizes, from, to, handled);  // a void within the step
+                          double to, const std::vector<char>& handled, const std::vector<int>& partner,
+                          detail::LocalRepairOptions& local) {
   for (size_t i = 0; i < events.size(); ++i) {
     const TopologyEvent& e = events[i];
     if (!in_step(e, from, to) || handled[i]) continue;
@@ -105,13 +105,14 @@ struct Morph::Impl {
   void overlay_at(double t, SkinComplex& out) const;  // into out's storage (see with_balls)
   std::vector<SkinComplex::KnownCell> known_cells(double t) const;  // the overlay cells' centres and sizes at t
   void finish_frame(double t, Clock::time_point start);
-  bool vanishing_left(double t, const std::vector<char>& handled) const;
+  bool vanishing_left(double t, const std::vector<char>& handled, const std::vector<int>& partner) const;
   // A frame after transport, relaxation and judging, before its repair.
   struct Transported {
     SurfaceMesh mesh;
     std::vector<char> failing;        // per triangle
     std::vector<char> drop;           // per vertex: lost (removed at a whole-frame remesh)
     std::vector<char> handled;        // per event: its vanishing component was dropped (drop_vanished)
+    std::vector<int> partner;         // per event: the event of the step it cancels, or -1 (cancelling_partners)
     long first_new_id = 0, before = 0;  // the first id this frame may give; vertices of the frame before
   };
   void mend_frame(const SkinComplex& next, double t, Transported& moved, const std::function<void()>& before_remesh);
@@ -391,9 +392,8 @@ std::vector<char> Morph::Impl::drop_vanished(double t, const std::vector<char>& 
 
 // Whether a component or void vanishes in (t_, t] that drop_vanished did
 // not drop (`handled`) and that was not born in the step itself
-// (cancelling_partners): the frame is then remeshed whole.
-bool Morph::Impl::vanishing_left(double t, const std::vector<char>& handled) const {
-  const std::vector<int> partner = cancelling_partners(events_, sizes_, t_, t, handled);
+// (`partner`): the frame is then remeshed whole.
+bool Morph::Impl::vanishing_left(double t, const std::vector<char>& handled, const std::vector<int>& partner) const {
   for (size_t i = 0; i < events_.size(); ++i) {
     const TopologyEvent& e = events_[i];
     if (in_step(e, t_, t) && takes_a_sphere(e) && !handled[i] && partner[i] < 0) return true;
@@ -429,6 +429,7 @@ const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
   auto stage_start = Clock::now();
   moved.drop = move_vertices(next, moved.mesh, stats, stayed);
   moved.handled = drop_vanished(t, stayed, moved.mesh, moved.drop, stats);
+  moved.partner = cancelling_partners(events_, sizes_, t_, t, moved.handled);  // voids born and gone in the step
   stats.seconds_transport = seconds_since(stage_start);
   // Too dense to be worth mending (a skin that shrank under it): afresh.
   if (stats.lost == 0 && too_dense(next, moved.mesh)) {
@@ -455,7 +456,7 @@ const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
   // remesh, which runs partly on both cores: overlapping that too saved
   // little and raised the peak memory (glibc's heap for the other thread).
   // The cell list and balls are made on this thread for the same reason.
-  const bool ahead = next_t > t && next_t < 1 && stats.lost == 0 && !vanishing_left(t, moved.handled);
+  const bool ahead = next_t > t && next_t < 1 && stats.lost == 0 && !vanishing_left(t, moved.handled, moved.partner);
   std::vector<SkinComplex::KnownCell> known;
   std::vector<Ball> balls;
   tbb::task_group lookahead;  // after what its task reads: if the repair throws, it waits before they go
@@ -489,7 +490,7 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
   detail::LocalRepairOptions local;
   local.crowded_below = options_.repair.crowded_below;
   local.policy = options_.repair.patch;
-  const bool mendable = stats.lost == 0 && add_topology_changes(events_, sizes_, t_, t, moved.handled, local);
+  const bool mendable = stats.lost == 0 && add_topology_changes(events_, sizes_, t_, t, moved.handled, moved.partner, local);
   long left = stats.bad_triangles;
   if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop);
   if (mendable && local.changes.empty() && left == 0) {
