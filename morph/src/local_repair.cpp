@@ -12,6 +12,8 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
+#include <numeric>
 #include <set>
 #include <unordered_map>
 
@@ -34,6 +36,7 @@ struct VertexStars {
       for (int v : mesh.triangles[static_cast<size_t>(f)])
         triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = f;
   }
+  bool empty(int v) const { return offset[static_cast<size_t>(v)] == offset[static_cast<size_t>(v) + 1]; }
   template <class Visit>
   void each(int v, Visit visit) const {
     for (int k = offset[static_cast<size_t>(v)]; k < offset[static_cast<size_t>(v) + 1]; ++k)
@@ -108,16 +111,14 @@ constexpr int kAttemptsBeforeGivingUp = 4;
 // Without them the Voronoi edge of a patch facet runs on across the gap, its
 // restricted point lies on the other sheet, and refinement meshes that sheet
 // a second time: the repair fails (a wrong topology, or too many points)
-// and the whole frame is remeshed. Near: within twice the longest edge of the
-// region's triangles, about the diameter of a patch facet's surface
-// Delaunay ball, and no farther than `cap` target lengths at the patch
-// vertex (infinite: no cap). False, with `role` part-marked, as soon as the
-// patch and its context pass `most` vertices.
-bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& region,
-                        const MeshingOptions& criteria, double cap, size_t most, std::vector<signed char>& role) {
-  // A region of seeds alone (a newborn component) takes the mesh's longest edge.
-  double longest = longest_edge(mesh, region);
-  if (!(longest > 0)) longest = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
+// and the whole frame is remeshed. Near: within twice `longest` (the
+// longest edge of the region's triangles, add_context), about the diameter
+// of a patch facet's surface Delaunay ball, and no farther than `cap` target
+// lengths at the patch vertex (infinite: no cap). False, with `role`
+// part-marked, as soon as the patch and its context pass `most` vertices.
+bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
+                        double longest, const MeshingOptions& criteria, double cap, size_t most,
+                        std::vector<signed char>& role) {
   if (!(longest > 0)) return true;
   const auto context = static_cast<signed char>(PatchRole::context);
   std::vector<double> reach(role.size(), 0.0);
@@ -138,8 +139,10 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
     return (int64_t{c.x()} & 0x1FFFFF) | ((int64_t{c.y()} & 0x1FFFFF) << 21) | ((int64_t{c.z()} & 0x1FFFFF) << 42);
   };
   std::unordered_map<int64_t, std::vector<int>> grid;  // vertices outside the patch, by grid cell
+  // A vertex no triangle uses (one an earlier part of the patch dropped) is no context.
   for (int v = 0; v < static_cast<int>(mesh.vertices.size()); ++v)
-    if (role[static_cast<size_t>(v)] == kNone) grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
+    if (role[static_cast<size_t>(v)] == kNone && !stars.empty(v))
+      grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
   size_t taken = static_cast<size_t>(std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; }));
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and the list could outgrow
@@ -176,16 +179,25 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
 // attempt then costing about a remesh of the whole frame. Past a quarter
 // of the frame the reach is capped at six target lengths. A small patch
 // keeps the uncapped reach: on small molecules the far context is what
-// lets a stretched patch succeed.
-void add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& region,
-                 const MeshingOptions& criteria, std::vector<signed char>& role) {
+// lets a stretched patch succeed. The measure is at least `at_least`: a
+// patch meshed again in pieces keeps the reach of the whole. Returns the
+// measure.
+double add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
+                   const std::vector<char>& region, double at_least, const MeshingOptions& criteria,
+                   std::vector<signed char>& role) {
   constexpr double kLargeShare = 0.25;       // of the frame's vertices
   constexpr double kCapInTargetLengths = 6;  // dimensionless
+  // A region of seeds alone (a newborn component) takes the mesh's longest edge.
+  double longest = std::max(longest_edge(mesh, region), at_least);
+  if (!(longest > 0)) longest = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
   const std::vector<signed char> patch = role;
   const auto large = static_cast<size_t>(kLargeShare * static_cast<double>(role.size()));
-  if (add_nearby_context(complex, mesh, region, criteria, std::numeric_limits<double>::infinity(), large, role)) return;
+  if (add_nearby_context(complex, mesh, stars, longest, criteria, std::numeric_limits<double>::infinity(), large,
+                         role))
+    return longest;
   role = patch;  // the uncapped search stopped once it passed a quarter
-  add_nearby_context(complex, mesh, region, criteria, kCapInTargetLengths, SIZE_MAX, role);
+  add_nearby_context(complex, mesh, stars, longest, criteria, kCapInTargetLengths, SIZE_MAX, role);
+  return longest;
 }
 
 // Interior vertices crowded together along a patch edge: the later one goes.
@@ -234,11 +246,14 @@ bool star_is_disk(int v, const std::vector<Triangle>& around) {
 }
 
 // The vertices of the mesh around which the seam fails: a patch vertex
-// whose triangles (kept ones plus the patch's) are not one disk, and the old corners of the patch triangles
-// around a new point whose star is not a disk. Empty when the seam holds.
-std::vector<int> seam_faults(const SurfaceMesh& merged, const std::vector<Triangle>& fresh,
-                             const std::vector<signed char>& role, const std::vector<char>& drop,
-                             size_t old_vertices) {
+// whose triangles (kept ones plus the patch's) are not one disk, and the old
+// corners of the patch triangles around a new point whose star is not a
+// disk. Empty when the seam holds. New points are numbered from
+// mesh.vertices.size() on.
+std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, const std::vector<char>& region,
+                             const std::vector<Triangle>& fresh, const std::vector<signed char>& role,
+                             const std::vector<char>& drop) {
+  const size_t old_vertices = mesh.vertices.size();
   auto in_patch = [&](int v) {
     return static_cast<size_t>(v) >= old_vertices ||
            role[static_cast<size_t>(v)] == static_cast<signed char>(PatchRole::interior) ||
@@ -247,9 +262,11 @@ std::vector<int> seam_faults(const SurfaceMesh& merged, const std::vector<Triang
   std::unordered_map<int, std::vector<Triangle>> around;
   for (const Triangle& t : fresh)
     for (int v : t) around[v].push_back(t);
-  for (const Triangle& t : merged.triangles)
-    for (int v : t)
-      if (in_patch(v)) around[v].push_back(t);
+  for (int v = 0; v < static_cast<int>(old_vertices); ++v)
+    if (in_patch(v))
+      stars.each(v, [&](int f) {
+        if (!region[static_cast<size_t>(f)]) around[v].push_back(mesh.triangles[static_cast<size_t>(f)]);
+      });
   std::vector<int> faults;
   for (size_t v = 0; v < old_vertices; ++v)  // an interior vertex may go; a rim vertex has kept triangles
     if (role[v] == static_cast<signed char>(PatchRole::boundary) && !drop[v] && !around.count(static_cast<int>(v)))
@@ -343,26 +360,61 @@ std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const PatchMeshRe
   return out;
 }
 
-// One attempt on `region`: the patch meshed and stitched into `merged`.
-// `faults` gets the vertices to grow the region around when the seam or a
-// new triangle fails.
+// One attempt on `region`: the patch meshed, not yet in the mesh. Its new
+// points are numbered from mesh.vertices.size() on. `faults` gets the
+// vertices to grow the region around where the seam or a new triangle fails.
 struct Attempt {
-  bool ok = false;
-  std::string failed_because;
-  SurfaceMesh merged;
-  long repairs = 0;
+  std::string failed_because;  // empty when the patch meshed and has no faults
+  std::vector<SkinSample> added;
+  std::vector<Triangle> fresh;  // the patch's triangles, replacing the region's
   std::vector<int> faults;
+  bool meshed = false;          // the refinement ended ok (faults may remain)
+  bool stopped = false;         // the refinement stopped (stalled, over budget)
+  long own = 0;                 // the patch's own points (its samples, less the context)
+  double reach_measure = 0;     // of its context (add_context), Angstrom
 };
 
-// `seeds_from`: the mesh's vertices from this index on are seeds on a newborn
-// component (no triangles yet), interior to the patch.
+// Per triangle of `fresh`, 1 where it fails `accept`; corners from `mesh`
+// or, numbered past it, from `added`.
+std::vector<char> failing_fresh(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                const std::vector<SkinSample>& added, const std::vector<Triangle>& fresh,
+                                const MeshingOptions& accept) {
+  const size_t n = mesh.vertices.size();
+  auto point = [&](int v) -> const SkinSample {
+    const auto u = static_cast<size_t>(v);
+    return u < n ? SkinSample{mesh.vertices[u], mesh.cells[u]} : added[u - n];
+  };
+  std::vector<char> bad(fresh.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, fresh.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t f = r.begin(); f != r.end(); ++f) {
+      const SkinSample a = point(fresh[f][0]), b = point(fresh[f][1]), c = point(fresh[f][2]);
+      bad[f] = !triangle_passes(complex, {a.point, b.point, c.point}, a.cell, accept);
+    }
+  });
+  return bad;
+}
+
+// What earlier attempts of a patch leave to the next: the pieces they put
+// in the mesh (their own points, the points they inserted) and the reach of
+// the context (add_context). A patch meshed again in pieces keeps the
+// budget (mesh_patch's: twice its own points plus 64, less what its pieces
+// inserted) and the reach of the whole: a piece alone, with less context,
+// can run away meshing the far side of a thin gap.
+struct SoFar {
+  long own = 0, inserted = 0;
+  double reach_measure = 0;  // Angstrom
+};
+
+// `seeds`: the mesh's vertices in [first, second) that no triangle uses
+// are seeds on a newborn component, interior to the patch.
 Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
-                  const std::vector<char>& region, size_t seeds_from, const MeshingOptions& repair,
-                  const MeshingOptions& accept, const LocalRepairOptions& options) {
+                  const std::vector<char>& region, std::pair<size_t, size_t> seeds, const SoFar& so_far,
+                  const MeshingOptions& repair, const MeshingOptions& accept, const LocalRepairOptions& options) {
   Attempt a;
   std::vector<signed char> role = vertex_roles(mesh, stars, region);
-  for (size_t v = seeds_from; v < role.size(); ++v) role[v] = static_cast<signed char>(PatchRole::interior);
-  add_context(complex, mesh, region, accept, role);
+  for (size_t v = seeds.first; v < seeds.second; ++v)
+    if (stars.empty(static_cast<int>(v))) role[v] = static_cast<signed char>(PatchRole::interior);
+  a.reach_measure = add_context(complex, mesh, stars, region, so_far.reach_measure, accept, role);
   const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, options.crowded_below);
   std::vector<PatchRole> roles;
   std::vector<int> index;
@@ -373,45 +425,126 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
                        std::to_string(mesh.vertices.size()) + " vertices)";
     return a;
   }
-  const PatchMeshResult patch = mesh_patch(complex, samples, roles, repair);
+  a.own = std::count_if(roles.begin(), roles.end(), [](PatchRole r) { return r != PatchRole::context; });
+  const long budget = 2 * (so_far.own + a.own) + 64 - so_far.inserted;
+  PatchMeshResult patch = mesh_patch(complex, samples, roles, repair, budget);
   if (patch.status != MeshingStatus::ok) {  // no faults: growing would not help
+    a.stopped = true;
     a.failed_because = std::string("the patch's refinement ended ") + meshing_status_name(patch.status) + " (" +
                        patch.message + ")";
     return a;
   }
-  a.merged.vertices = mesh.vertices;
-  a.merged.cells = mesh.cells;
-  a.merged.normals = mesh.normals;
-  for (const SkinSample& p : patch.added) {
-    a.merged.vertices.push_back(p.point);
-    a.merged.cells.push_back(p.cell);
-    a.merged.normals.push_back(complex.evaluate(p.point, p.cell).gradient.normalized());
-  }
+  a.meshed = true;
   std::set<Triangle> kept_near;  // kept triangles at the rim, by sorted corners
-  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
-    if (region[f]) continue;
-    a.merged.triangles.push_back(mesh.triangles[f]);
-    Triangle key = mesh.triangles[f];
-    std::sort(key.begin(), key.end());
-    if (std::any_of(key.begin(), key.end(), [&](int v) { return role[static_cast<size_t>(v)] != kNone; }))
-      kept_near.insert(key);
-  }
-  const std::vector<Triangle> fresh = patch_triangles(mesh, patch, index, kept_near);
-  a.faults = seam_faults(a.merged, fresh, role, drop, mesh.vertices.size());
-  const std::vector<char> bad = failing_triangles(complex, a.merged, fresh, accept);
-  for (size_t f = 0; f < fresh.size(); ++f)
+  for (int v = 0; v < static_cast<int>(role.size()); ++v)
+    if (role[static_cast<size_t>(v)] != kNone)
+      stars.each(v, [&](int f) {
+        if (region[static_cast<size_t>(f)]) return;
+        Triangle key = mesh.triangles[static_cast<size_t>(f)];
+        std::sort(key.begin(), key.end());
+        kept_near.insert(key);
+      });
+  a.fresh = patch_triangles(mesh, patch, index, kept_near);
+  a.added = std::move(patch.added);
+  a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop);
+  const std::vector<char> bad = failing_fresh(complex, mesh, a.added, a.fresh, accept);
+  for (size_t f = 0; f < a.fresh.size(); ++f)
     if (bad[f])
-      for (int v : fresh[f])
+      for (int v : a.fresh[f])
         if (static_cast<size_t>(v) < mesh.vertices.size()) a.faults.push_back(v);
-  if (!a.faults.empty()) {
+  if (!a.faults.empty())
     a.failed_because = std::to_string(a.faults.size()) + " seam or criteria faults left after growing the patch";
-    return a;
-  }
-  a.merged.triangles.insert(a.merged.triangles.end(), fresh.begin(), fresh.end());
-  a.repairs = patch.stats.inserted_size + patch.stats.inserted_shape + patch.stats.inserted_distance +
-              patch.stats.inserted_topology;
-  a.ok = true;
   return a;
+}
+
+// The parts of an attempt that hold: pieces of the region joined with the
+// patch triangles that replace them (vertices shared by region or patch
+// triangles make one piece) and holding no fault. Such a piece is stitched
+// with disk stars all round and every new triangle passing, whatever the
+// other pieces do: kept triangles separate it from them.
+struct Holding {
+  std::vector<char> region;  // per triangle of the mesh: in the region and in a piece that holds
+  std::vector<char> fresh;   // per triangle of the attempt: in a piece that holds
+  long pieces = 0, faulty = 0;
+  long own = 0;  // vertices of the region's triangles in pieces that hold
+};
+
+Holding holding_pieces(const SurfaceMesh& mesh, const std::vector<char>& region, const Attempt& a) {
+  const size_t n = mesh.vertices.size();
+  std::vector<size_t> parent(n + a.added.size());
+  std::iota(parent.begin(), parent.end(), size_t{0});
+  const auto find = [&](size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  const auto join = [&](const Triangle& t) {
+    for (size_t k = 1; k < 3; ++k) parent[find(static_cast<size_t>(t[k]))] = find(static_cast<size_t>(t[0]));
+  };
+  for (size_t f = 0; f < region.size(); ++f)
+    if (region[f]) join(mesh.triangles[f]);
+  for (const Triangle& t : a.fresh) join(t);
+  std::vector<char> faulty(parent.size(), 0);
+  for (int v : a.faults) faulty[find(static_cast<size_t>(v))] = 1;
+  Holding h;
+  h.region.assign(region.size(), 0);
+  std::vector<char> seen(parent.size(), 0);
+  for (size_t f = 0; f < region.size(); ++f) {
+    if (!region[f]) continue;
+    const size_t root = find(static_cast<size_t>(mesh.triangles[f][0]));
+    h.region[f] = !faulty[root];
+    if (!seen[root]) {
+      seen[root] = 1;
+      ++h.pieces;
+      h.faulty += faulty[root];
+    }
+  }
+  std::vector<char> own(n, 0);
+  for (size_t f = 0; f < region.size(); ++f)
+    if (h.region[f])
+      for (int v : mesh.triangles[f]) own[static_cast<size_t>(v)] = 1;
+  h.own = std::count(own.begin(), own.end(), 1);
+  h.fresh.resize(a.fresh.size());
+  for (size_t f = 0; f < a.fresh.size(); ++f) h.fresh[f] = !faulty[find(static_cast<size_t>(a.fresh[f][0]))];
+  return h;
+}
+
+// The pieces of `a` that hold put into `mesh` (new points appended, in the
+// order the patch made them); `region` follows the mesh's triangles (the
+// region's triangles not replaced, none of the new ones). Returns the
+// points added.
+long put_in(const SkinComplex& complex, SurfaceMesh& mesh, std::vector<char>& region, const Attempt& a,
+            const Holding& h) {
+  const size_t n = mesh.vertices.size();
+  std::vector<Triangle> triangles;
+  std::vector<char> still;
+  triangles.reserve(mesh.triangles.size() + a.fresh.size());
+  for (size_t f = 0; f < mesh.triangles.size(); ++f)
+    if (!h.region[f]) {
+      triangles.push_back(mesh.triangles[f]);
+      still.push_back(region[f]);
+    }
+  std::vector<int> placed(a.added.size(), -1);
+  for (size_t f = 0; f < a.fresh.size(); ++f) {
+    if (!h.fresh[f]) continue;
+    Triangle t = a.fresh[f];
+    for (int& v : t) {
+      if (static_cast<size_t>(v) < n) continue;
+      int& at = placed[static_cast<size_t>(v) - n];
+      if (at < 0) {
+        const SkinSample& p = a.added[static_cast<size_t>(v) - n];
+        at = static_cast<int>(mesh.vertices.size());
+        mesh.vertices.push_back(p.point);
+        mesh.cells.push_back(p.cell);
+        mesh.normals.push_back(complex.evaluate(p.point, p.cell).gradient.normalized());
+      }
+      v = at;
+    }
+    triangles.push_back(t);
+    still.push_back(0);
+  }
+  mesh.triangles = std::move(triangles);
+  region = std::move(still);
+  return static_cast<long>(mesh.vertices.size() - n);
 }
 
 }  // namespace
@@ -465,36 +598,65 @@ bool topology_as_expected(const SurfaceMesh& before, const SurfaceMesh& after, c
   return std::abs(components_after - components_before) <= static_cast<long>(options.changes.size());
 }
 
-}  // namespace
+// How an attempt after the first meshes the patch: only the pieces that did
+// not hold (the others go into the mesh at once), or the whole region again.
+enum class Retry { pieces, whole };
 
-RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
-                           const MeshingOptions& repair, const MeshingOptions& accept,
-                           const LocalRepairOptions& options) {
+// How the attempts on a patch in pieces ended, when they failed.
+struct PiecesFailure {
+  bool put_in = false;       // some attempt put pieces in the mesh
+  bool ran_away = false;     // the last attempt's refinement stopped (stalled, over budget)
+};
+
+// The attempts on one patch.
+RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
+                            const MeshingOptions& repair, const MeshingOptions& accept,
+                            const LocalRepairOptions& options, Retry retry, PiecesFailure& failure) {
   RepairResult out;
-  // The frame is copied only when seeds are to be added to it.
-  const bool births = std::any_of(options.changes.begin(), options.changes.end(),
-                                  [](const TopologyChange& c) { return c.birth; });
-  SurfaceMesh seeded;
-  if (births) seeded = with_birth_seeds(complex, given, options.changes);
-  const SurfaceMesh& mesh = births ? seeded : given;
-  const VertexStars stars(mesh);
+  // The frame as the patch's pieces go into it, with seeds on newborn components.
+  SurfaceMesh mesh = with_birth_seeds(complex, given, options.changes);
+  const std::pair<size_t, size_t> seeds{given.vertices.size(), mesh.vertices.size()};
+  auto stars = std::make_unique<VertexStars>(mesh);
   std::vector<char> region = failing;
   mark_near_changes(mesh, options.changes, region);
-  region = grow_region(mesh, stars, std::move(region), options.policy.rings);
+  region = grow_region(mesh, *stars, std::move(region), options.policy.rings);
   size_t fewest = SIZE_MAX;  // the fewest faults an attempt left
   int since_fewest = 0;
+  SoFar so_far;
   for (int attempt = 0; attempt < options.policy.attempts; ++attempt) {
-    Attempt a = try_patch(complex, mesh, stars, region, given.vertices.size(), repair, accept, options);
-    if (a.ok) {
-      if (!topology_as_expected(given, a.merged, options)) {
+    ++out.attempts;
+    out.attempted_triangles += std::count(region.begin(), region.end(), 1);
+    const Attempt a = try_patch(complex, mesh, *stars, region, seeds, so_far, repair, accept, options);
+    so_far.reach_measure = std::max(so_far.reach_measure, a.reach_measure);
+    if (!a.meshed) {  // no faults: growing would not help
+      out.failed_because = a.failed_because;
+      failure.ran_away = a.stopped;
+      return out;
+    }
+    // The pieces that hold go in now (all of them when there are no
+    // faults); the next attempt remeshes the others, grown around their faults.
+    const Holding holding = holding_pieces(mesh, region, a);
+    const bool put = a.faults.empty() || (retry == Retry::pieces && holding.faulty < holding.pieces);
+    if (put) {
+      out.counts.patch_triangles += std::count(holding.region.begin(), holding.region.end(), 1);
+      const long inserted = put_in(complex, mesh, region, a, holding);
+      out.counts.insertions += inserted;
+      so_far.own += holding.own;
+      so_far.inserted += inserted;
+      if (!a.faults.empty()) {
+        failure.put_in = true;
+        stars = std::make_unique<VertexStars>(mesh);
+      }
+    }
+    if (a.faults.empty()) {
+      if (!topology_as_expected(given, mesh, options)) {
         out.failed_because = "the patched mesh's Euler characteristic or components are not what the topology "
                              "changes say";
         return out;
       }
-      out.counts.patch_triangles = std::count(region.begin(), region.end(), 1);
-      compact(a.merged, given.vertices.size(), out);
-      out.counts.insertions = a.repairs;
+      compact(mesh, given.vertices.size(), out);
       out.ok = true;
+      out.failed_because.clear();  // an earlier attempt's
       return out;
     }
     out.failed_because = a.failed_because;
@@ -502,7 +664,6 @@ RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given
     // it is going to succeed, at times more for an attempt or two. Past the
     // first kAttemptsBeforeGivingUp, two attempts in a row that left no
     // fewer faults than the fewest before end it.
-    if (a.faults.empty()) return out;
     if (a.faults.size() < fewest) {
       fewest = a.faults.size();
       since_fewest = 0;
@@ -510,8 +671,8 @@ RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given
       return out;
     }
     std::vector<char> more(region.size(), 0);
-    for (int v : a.faults) stars.each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });
-    more = grow_region(mesh, stars, std::move(more), 1);
+    for (int v : a.faults) stars->each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });
+    more = grow_region(mesh, *stars, std::move(more), 1);
     bool grew = false;
     for (size_t f = 0; f < region.size(); ++f)
       if (more[f] && !region[f]) region[f] = grew = true;
@@ -519,6 +680,27 @@ RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given
     if (!grew) return out;
   }
   return out;
+}
+
+}  // namespace
+
+// Retrying only the pieces that did not hold is cheaper, but a piece alone
+// can fail where the whole region succeeds: its refinement runs away with
+// less of the patch around it. Then the whole region is tried as well. (A
+// patch in pieces that ends with faults or the wrong Euler characteristic
+// ended the same way whole on bench_moving's 3mht motions.)
+RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
+                           const MeshingOptions& repair, const MeshingOptions& accept,
+                           const LocalRepairOptions& options) {
+  PiecesFailure failure;
+  if (!options.policy.retry_in_pieces)
+    return patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, failure);
+  RepairResult out = patch_attempts(complex, given, failing, repair, accept, options, Retry::pieces, failure);
+  if (out.ok || !failure.put_in || !failure.ran_away) return out;
+  RepairResult whole = patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, failure);
+  whole.attempts += out.attempts;
+  whole.attempted_triangles += out.attempted_triangles;
+  return whole;
 }
 
 }  // namespace skinmesh::detail

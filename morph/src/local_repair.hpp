@@ -3,8 +3,10 @@
 // restricted Delaunay refinement of their own vertices (mesher's mesh_patch,
 // with a ring of context vertices around them) and stitched back. The seam
 // is checked: every vertex of the patch must end with one disk of
-// triangles, and every new triangle must meet the criteria; otherwise the
-// repair reports failure and the caller grows the patch or remeshes the frame.
+// triangles, and every new triangle must meet the criteria. Where it fails,
+// the patch is grown around the faults and meshed again (only its pieces
+// with faults, PatchPolicy::retry_in_pieces); when the attempts end with
+// faults left, the repair reports failure and the caller remeshes the frame.
 #pragma once
 
 #include "repair_result.hpp"
@@ -49,7 +51,8 @@ struct LocalRepairOptions {
 // the skin of `complex` (all zero is fine when options.changes is not
 // empty). The patch is refined to `repair` (stricter, for room before the
 // next failure); its new triangles must meet `accept`.
-// The result: ok, or failed_because; counts.insertions and patch_triangles.
+// The result: ok, or failed_because; counts.insertions and patch_triangles,
+// attempts and attempted_triangles.
 RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options);

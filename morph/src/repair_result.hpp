@@ -27,6 +27,8 @@ struct RepairResult {
   std::vector<char> failing;   // edits: per triangle of `mesh`, still failing the frame criteria
   long left = 0;               // edits: triangles still failing
   long thin_tried = 0;         // edits: edges thinning tried to contract
+  long attempts = 0;           // local patch: attempts made (with a second round whole, both rounds')
+  long attempted_triangles = 0;  // local patch: triangles of the region each attempt remeshed, summed
   RepairCounts counts;
 };
 

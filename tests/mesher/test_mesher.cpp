@@ -457,6 +457,12 @@ TEST_CASE("mesh_patch: a patch that needs more than twice its own points stops, 
   const PatchMeshResult stopped = mesh_patch(complex, sparse.samples, sparse.roles, options);
   CHECK(stopped.status == MeshingStatus::stalled);
   CHECK(stopped.message == "the patch needed more than twice its own points");
+  // With a budget from its caller (a piece of a larger patch keeps the
+  // whole's) the same cap is meshed.
+  const PatchMeshResult budgeted =
+      mesh_patch(complex, sparse.samples, sparse.roles, options, 2 * sparse.interior_left_out + 64);
+  CHECK(budgeted.status == MeshingStatus::ok);
+  CHECK(static_cast<long>(budgeted.added.size()) > 2 * sparse.own + 64);
   // The same cap with a few of its interior vertices left out is a local
   // repair: it is meshed, and its triangles lie in the cap.
   const CapPatch dense = cap_patch(sphere.mesh, 0.0, 1);

@@ -2,14 +2,21 @@
 // (morph/src/surgery.hpp, local_repair.hpp): the edits' thinning, where an
 // edge whose contraction was refused is not tried again in the next frame
 // unless it has shrunk or its refusal has aged; and the local repair, which
-// leaves a patch that is nearly the whole frame to the whole-frame remesh.
+// leaves a patch that is nearly the whole frame to the whole-frame remesh
+// and, after an attempt with faults, meshes again only the pieces that had
+// them.
 #include <catch2/catch.hpp>
 
 #include "test_support.hpp"
 
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/quality/guarantees.hpp"
+#include "judge.hpp"
 #include "local_repair.hpp"
 #include "surgery.hpp"
+
+#include <Eigen/Geometry>
 
 #include <numeric>
 
@@ -95,4 +102,71 @@ TEST_CASE("local repair: a patch that would take nearly every vertex is left to 
   const detail::RepairResult meshed = repair();
   CHECK(meshed.ok);
   CHECK(meshed.counts.patch_triangles == static_cast<long>(f.mesh.triangles.size()));
+}
+
+TEST_CASE("local repair: after an attempt with faults only the pieces that had them are meshed again", "[morph]") {
+  // Ubiquitin's last 32 atoms (the C-terminal strand) turned by 2 degrees
+  // about an atom at the strand's foot; each vertex projected onto the new
+  // skin from where its owning ball took it; the edits first, as a frame's
+  // repair does. What they leave is patched with and without retrying in pieces.
+  const std::vector<Ball> before = test::centred_model(test::data_file("1ubi.pdb"), 1);
+  constexpr size_t kStrand = 570;
+  REQUIRE(before.size() > kStrand);
+  std::vector<Ball> after = before;
+  const Eigen::Vector3d pivot = before[kStrand].center;
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (size_t i = kStrand; i < after.size(); ++i) after[i].center = pivot + turn * (before[i].center - pivot);
+  const SkinComplex from = build_skin_complex(before), to = build_skin_complex(after);
+  MeshingOptions accept;
+  accept.min_angle = 20;
+  SkinMeshResult made = mesh_skin(from, accept);
+  REQUIRE(made.status == MeshingStatus::ok);
+  SurfaceMesh moved = made.mesh;
+  for (size_t v = 0; v < moved.vertices.size(); ++v) {
+    const int owner = from.owning_ball(moved.vertices[v], moved.cells[v]);
+    const auto b = static_cast<size_t>(owner);
+    Eigen::Vector3d offset = moved.vertices[v] - before[b].center;
+    if (b >= kStrand) offset = turn * offset;
+    const Projection p = to.project(after[b].center + offset, to.vertex_cell(owner), 1e-14);
+    REQUIRE(p.converged);
+    moved.vertices[v] = p.point;
+    moved.cells[v] = p.cell;
+    moved.normals[v] = to.evaluate(p.point, p.cell).gradient.normalized();
+  }
+  const std::vector<char> failing = detail::failing_triangles(to, moved, moved.triangles, accept);
+  const detail::RepairResult edited = detail::mend_by_edits(to, moved, failing, accept, EditPolicy{});
+  REQUIRE(edited.left > 0);
+  detail::LocalRepairOptions options;
+  options.euler_change = skin_topology(after).euler - skin_topology(before).euler;
+  auto patch = [&](bool in_pieces) {
+    options.policy.retry_in_pieces = in_pieces;
+    return detail::repair_locally(to, edited.mesh, edited.failing, accept, accept, options);
+  };
+  const detail::RepairResult whole = patch(false), pieces = patch(true);
+  REQUIRE(whole.ok);
+  REQUIRE(whole.attempts >= 2);  // the frame needs a second attempt
+  REQUIRE(pieces.ok);
+  CHECK(pieces.failed_because.empty());
+  // Later attempts mesh only what had faults: fewer triangles in all.
+  CHECK(pieces.attempted_triangles < whole.attempted_triangles);
+  // The frame the pieces made: every triangle passes the frame's criteria,
+  // and the static mesher's guarantees hold by the independent check (on
+  // the skin by the oracle, closed oriented manifold, no self-intersections,
+  // the skin's topology).
+  const std::vector<char> still = detail::failing_triangles(to, pieces.mesh, pieces.mesh.triangles, accept);
+  CHECK(std::count(still.begin(), still.end(), 1) == 0);
+  GuaranteeOptions guarantees;
+  guarantees.min_angle = 20;
+  guarantees.on_skin_tolerance = 1e-8;
+  const GuaranteeReport report = check_guarantees(pieces.mesh, after, 0.5, guarantees);
+  CHECK(report.all_hold());
+  // A kept vertex stays where it was.
+  REQUIRE(pieces.origin.size() == pieces.mesh.vertices.size());
+  long kept = 0;
+  for (size_t v = 0; v < pieces.origin.size(); ++v)
+    if (pieces.origin[v] >= 0) {
+      ++kept;
+      CHECK(pieces.mesh.vertices[v] == edited.mesh.vertices[static_cast<size_t>(pieces.origin[v])]);
+    }
+  CHECK(kept > 0);
 }

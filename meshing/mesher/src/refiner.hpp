@@ -221,7 +221,8 @@ class Refiner {
   // Seeds the skin, or starts from `samples` (remesh_skin) when given.
   SkinMeshResult run(const std::vector<SkinSample>* samples = nullptr);
   // mesh_patch: the samples with their roles, refined where patch facets fail.
-  PatchMeshResult run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles);
+  PatchMeshResult run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles,
+                            long least_budget = 0);
 
  private:
   // Calls visit(facet, key) once for every finite facet with a vertex in
@@ -346,7 +347,7 @@ class Refiner {
   int sample_ids_ = 0;  // ids below this are the given samples' indices (remesh_skin, mesh_patch)
   std::vector<int> star_slot_;  // by vertex id: its place in repair_stars' list, else -1
   std::vector<PatchRole> roles_;  // by sample id (mesh_patch); empty for the whole skin
-  long patch_points_ = 0;         // samples of the patch itself (not its context)
+  long patch_budget_ = 0;         // insertions a patch may make (mesh_patch)
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();
   double expected_vertices_ = 0;

@@ -169,8 +169,8 @@ void Refiner::report(const char* stage, Report when, long pending) {
 
 void Refiner::check_budget() const {
   // A patch that needs more than twice its own points (its context not
-  // counted) is not a local repair.
-  if (!roles_.empty() && next_id_ - sample_ids_ > 2 * patch_points_ + 64)
+  // counted), or than the budget its caller gave, is not a local repair.
+  if (!roles_.empty() && next_id_ - sample_ids_ > patch_budget_)
     throw RefinementStopped{MeshingStatus::stalled, "the patch needed more than twice its own points", stats_};
   // A closed surface mesh has about twice as many triangles as vertices.
   const long estimate = 2 * static_cast<long>(dt_.number_of_vertices());
@@ -1033,10 +1033,12 @@ SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
   return result;
 }
 
-PatchMeshResult Refiner::run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles) {
+PatchMeshResult Refiner::run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles,
+                                   long least_budget) {
   const auto start = Clock::now();
   roles_ = roles;
-  patch_points_ = std::count_if(roles.begin(), roles.end(), [](PatchRole r) { return r != PatchRole::context; });
+  const long own = std::count_if(roles.begin(), roles.end(), [](PatchRole r) { return r != PatchRole::context; });
+  patch_budget_ = std::max(2 * own + 64, least_budget);
   insert_samples(samples);
   refine_until_clean();
   PatchMeshResult result;
@@ -1231,7 +1233,7 @@ SkinMeshResult remesh_skin(const SkinComplex& complex, const std::vector<SkinSam
 }
 
 PatchMeshResult mesh_patch(const SkinComplex& complex, const std::vector<SkinSample>& samples,
-                           const std::vector<PatchRole>& roles, const MeshingOptions& options) {
+                           const std::vector<PatchRole>& roles, const MeshingOptions& options, long least_budget) {
   check_options(options);
   if (roles.size() != samples.size()) contract_error("mesh_patch: one role per sample");
   std::optional<tbb::global_control> threads;
@@ -1239,7 +1241,7 @@ PatchMeshResult mesh_patch(const SkinComplex& complex, const std::vector<SkinSam
     threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
   detail::Refiner refiner(complex, options);
   try {
-    return refiner.run_patch(samples, roles);
+    return refiner.run_patch(samples, roles, least_budget);
   } catch (const detail::RefinementStopped& stop) {
     PatchMeshResult result;
     result.status = stop.status;

@@ -52,6 +52,14 @@ struct PatchPolicy {
   // past the fourth, not after two attempts in a row that left no fewer
   // faults than the fewest before.
   int attempts = 10;
+  // After an attempt that left faults, the pieces of the patch that hold (no
+  // fault; kept triangles part them from the rest) go into the mesh, and the
+  // next attempt remeshes only the others, grown around their faults. Most
+  // of a patch holds at the first attempt, so later attempts cost a
+  // fraction of it. A piece whose refinement runs away alone (stalls) is
+  // tried once more with the whole region. false: every attempt remeshes
+  // the whole region.
+  bool retry_in_pieces = true;
   // A patch whose samples (with their context) pass this share of the
   // frame's vertices is not tried (a share, 0-1): it is nearly the whole
   // frame, which the whole-frame remesh does once, where a patch may be

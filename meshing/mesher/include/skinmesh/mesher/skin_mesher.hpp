@@ -220,7 +220,12 @@ struct PatchMeshResult {
   std::vector<std::array<long, 3>> triangles;
   MeshingStats stats;
 };
+// The refinement stops (status stalled) once it has inserted more than
+// twice the patch's own points (its context not counted) plus 64, or more
+// than `least_budget` points when that is larger: a caller that meshes a
+// patch again in pieces keeps the budget the whole patch had.
 PatchMeshResult mesh_patch(const SkinComplex& complex, const std::vector<SkinSample>& samples,
-                           const std::vector<PatchRole>& roles, const MeshingOptions& options = {});
+                           const std::vector<PatchRole>& roles, const MeshingOptions& options = {},
+                           long least_budget = 0);
 
 }  // namespace skinmesh
