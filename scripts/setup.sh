@@ -17,7 +17,6 @@ packages=(
   libtbb-dev                                        # threads
   libcli11-dev                                      # command line
   nlohmann-json3-dev                                # JSON reports
-  robin-map-dev                                     # flat hash map (the morph's mesh edits)
   libpng-dev                                        # PNG pictures (skinmesh render)
   pybind11-dev python3-dev python3-numpy            # the Python module (docs/python.md)
   python3-pytest python3-meshio python3-mdanalysis  # its tests: pytest, meshio, MD trajectories
