@@ -623,11 +623,19 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
   size_t fewest = SIZE_MAX;  // the fewest faults an attempt left
   int since_fewest = 0;
   SoFar so_far;
+  bool widened = false;
   for (int attempt = 0; attempt < options.policy.attempts; ++attempt) {
     ++out.attempts;
     out.attempted_triangles += std::count(region.begin(), region.end(), 1);
     const Attempt a = try_patch(complex, mesh, *stars, region, seeds, so_far, repair, accept, options);
     so_far.reach_measure = std::max(so_far.reach_measure, a.reach_measure);
+    // A refinement that stalls is most often meshing the far side of a thin
+    // gap its context missed: the same region once more, reaching farther.
+    if (a.stopped && !widened && options.policy.stalled_reach_scale > 1) {
+      widened = true;
+      so_far.reach_measure = options.policy.stalled_reach_scale * a.reach_measure;
+      continue;
+    }
     if (!a.meshed) {  // no faults: growing would not help
       out.failed_because = a.failed_because;
       failure.ran_away = a.stopped;
