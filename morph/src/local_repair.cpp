@@ -634,8 +634,11 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
     if (a.stopped && !widened && options.policy.stalled_reach_scale > 1) {
       widened = true;
       so_far.reach_measure = options.policy.stalled_reach_scale * a.reach_measure;
+      out.failed_because = a.failed_because;  // should this have been the last attempt
+      failure.ran_away = true;
       continue;
     }
+    failure.ran_away = false;
     if (!a.meshed) {  // no faults: growing would not help
       out.failed_because = a.failed_because;
       failure.ran_away = a.stopped;
