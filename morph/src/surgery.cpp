@@ -16,7 +16,6 @@
 #include <unordered_map>
 #include <utility>
 
-
 namespace skinmesh::detail {
 namespace {
 
@@ -44,29 +43,24 @@ class EdgeIndex {
   }
   // The triangle holding edge from -> to, or -1.
   int face(int from, int to) const {
-    const size_t v = static_cast<size_t>(from);
-    for (int k = start_[v], end = start_[v] + count_[v]; k < end; ++k)
-      if (slots_[static_cast<size_t>(k)].first == to) return slots_[static_cast<size_t>(k)].second;
-    return -1;
+    const int k = slot(from, to);
+    return k < 0 ? -1 : slots_[static_cast<size_t>(k)].second;
   }
   void set(int from, int to, int f) {
+    const int k = slot(from, to);
+    if (k >= 0) {
+      slots_[static_cast<size_t>(k)].second = f;
+      return;
+    }
     const size_t v = static_cast<size_t>(from);
-    for (int k = start_[v], end = start_[v] + count_[v]; k < end; ++k)
-      if (slots_[static_cast<size_t>(k)].first == to) {
-        slots_[static_cast<size_t>(k)].second = f;
-        return;
-      }
     if (count_[v] == room_[v]) grow(v);
     slots_[static_cast<size_t>(start_[v] + count_[v]++)] = {to, f};
   }
   void erase(int from, int to) {
+    const int k = slot(from, to);
+    if (k < 0) return;
     const size_t v = static_cast<size_t>(from);
-    for (int k = start_[v], end = start_[v] + count_[v]; k < end; ++k)
-      if (slots_[static_cast<size_t>(k)].first == to) {
-        slots_[static_cast<size_t>(k)] = slots_[static_cast<size_t>(end - 1)];
-        --count_[v];
-        return;
-      }
+    slots_[static_cast<size_t>(k)] = slots_[static_cast<size_t>(start_[v] + --count_[v])];
   }
   void add_vertex() {
     start_.push_back(static_cast<int>(slots_.size()));
@@ -83,6 +77,13 @@ class EdgeIndex {
 
  private:
   static constexpr int kSpare = 4;  // room for edges an edit adds to a vertex
+  // Where edge from -> to is in `slots`, or -1.
+  int slot(int from, int to) const {
+    const size_t v = static_cast<size_t>(from);
+    for (int k = start_[v], end = start_[v] + count_[v]; k < end; ++k)
+      if (slots_[static_cast<size_t>(k)].first == to) return k;
+    return -1;
+  }
   void grow(size_t v) {
     const int at = static_cast<int>(slots_.size());
     slots_.resize(slots_.size() + static_cast<size_t>(2 * room_[v]));
