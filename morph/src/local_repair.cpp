@@ -3,18 +3,16 @@
 #include "judge.hpp"
 #include "mesh_part.hpp"
 
+#include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
-#include <map>
 #include <memory>
 #include <numeric>
-#include <set>
 #include <unordered_map>
 
 namespace skinmesh::detail {
@@ -138,10 +136,22 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   auto key = [](const Eigen::Vector3i& c) {  // 21 bits a coordinate
     return (int64_t{c.x()} & 0x1FFFFF) | ((int64_t{c.y()} & 0x1FFFFF) << 21) | ((int64_t{c.z()} & 0x1FFFFF) << 42);
   };
+  // Only vertices in the patch's bounding box grown by the longest reach
+  // can be near it: the grid holds those, not the whole frame.
+  Eigen::AlignedBox3d near_box;
+  double farthest = 0;
+  for (size_t v = 0; v < role.size(); ++v)
+    if (reach[v] > 0) {
+      near_box.extend(mesh.vertices[v]);
+      farthest = std::max(farthest, reach[v]);
+    }
+  near_box.min().array() -= farthest;
+  near_box.max().array() += farthest;
   std::unordered_map<int64_t, std::vector<int>> grid;  // vertices outside the patch, by grid cell
   // A vertex no triangle uses (one an earlier part of the patch dropped) is no context.
   for (int v = 0; v < static_cast<int>(mesh.vertices.size()); ++v)
-    if (role[static_cast<size_t>(v)] == kNone && !stars.empty(v))
+    if (role[static_cast<size_t>(v)] == kNone && near_box.contains(mesh.vertices[static_cast<size_t>(v)]) &&
+        !stars.empty(v))
       grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
   size_t taken = static_cast<size_t>(std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; }));
   // Marked at once, each vertex once: gathered in a list first, a vertex
@@ -285,7 +295,7 @@ std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, 
 // counted where a triangle uses them).
 std::pair<long, long> components_and_euler(const SurfaceMesh& mesh) {
   std::vector<int> parent(mesh.vertices.size(), -1);
-  std::function<int(int)> root = [&](int v) {
+  const auto root = [&parent](int v) {
     while (parent[static_cast<size_t>(v)] != v) {
       int& up = parent[static_cast<size_t>(v)];
       up = parent[static_cast<size_t>(up)];  // path halving
@@ -345,7 +355,7 @@ std::vector<SkinSample> patch_samples(const SurfaceMesh& mesh, const std::vector
 // The patch's triangles in the mesh's numbering (new points after the
 // mesh's vertices), without those the mesh keeps already.
 std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const PatchMeshResult& patch,
-                                      const std::vector<int>& index, const std::set<Triangle>& kept_near) {
+                                      const std::vector<int>& index, const std::vector<Triangle>& kept_near) {
   const long n = static_cast<long>(index.size());
   std::vector<Triangle> out;
   for (const auto& t : patch.triangles) {
@@ -355,7 +365,7 @@ std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const PatchMeshRe
                       : static_cast<int>(mesh.vertices.size() + static_cast<size_t>(t[k] - n));
     Triangle key = g;
     std::sort(key.begin(), key.end());
-    if (!kept_near.count(key)) out.push_back(g);
+    if (!std::binary_search(kept_near.begin(), kept_near.end(), key)) out.push_back(g);
   }
   return out;
 }
@@ -435,15 +445,17 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
     return a;
   }
   a.meshed = true;
-  std::set<Triangle> kept_near;  // kept triangles at the rim, by sorted corners
+  std::vector<Triangle> kept_near;  // kept triangles at the rim, by sorted corners, sorted
   for (int v = 0; v < static_cast<int>(role.size()); ++v)
     if (role[static_cast<size_t>(v)] != kNone)
       stars.each(v, [&](int f) {
         if (region[static_cast<size_t>(f)]) return;
         Triangle key = mesh.triangles[static_cast<size_t>(f)];
         std::sort(key.begin(), key.end());
-        kept_near.insert(key);
+        kept_near.push_back(key);
       });
+  std::sort(kept_near.begin(), kept_near.end());
+  kept_near.erase(std::unique(kept_near.begin(), kept_near.end()), kept_near.end());
   a.fresh = patch_triangles(mesh, patch, index, kept_near);
   a.added = std::move(patch.added);
   a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop);
