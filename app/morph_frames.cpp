@@ -276,6 +276,7 @@ json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::stri
   json j = frame_json(s, c, file);
   j["steps"] = s.steps;
   j["reidentified"] = s.reidentified;
+  j["settled"] = s.settled;
   j["ids_kept"] = s.ids_kept;
   j["max_kept_move"] = s.max_kept_move;
   return j;

@@ -57,10 +57,17 @@ void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
 }
 
 Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,
-                       const MeshingOptions& criteria) {
+                       const MeshingOptions& criteria, const std::vector<char>* settled) {
   Judged j;
   auto stage = Clock::now();
-  j.failing = failing_triangles(complex, mesh, mesh.triangles, criteria);
+  if (settled != nullptr && settled->size() == mesh.vertices.size()) {
+    std::vector<char> unsettled(mesh.vertices.size());
+    std::transform(settled->begin(), settled->end(), unsettled.begin(), [](char s) { return static_cast<char>(!s); });
+    j.failing.assign(mesh.triangles.size(), 0);
+    rejudge_moved(complex, mesh, unsettled, criteria, j.failing);
+  } else {
+    j.failing = failing_triangles(complex, mesh, mesh.triangles, criteria);
+  }
   j.failing_before_relax = std::count(j.failing.begin(), j.failing.end(), 1);
   j.seconds_judge = seconds_since(stage);
   if (j.failing_before_relax == 0 || relaxation.passes == 0) return j;

@@ -50,13 +50,15 @@ void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
 // every triangle judged, the corners of those that fail relaxed along the
 // skin (relaxation.hpp; none when options.passes is 0), and the triangles
 // those moves touched judged again. The other vertices stay on their
-// closed-form paths.
+// closed-form paths. A triangle whose three corners `settled` marks (per
+// vertex; empty or null: none) is taken as passing unjudged: the caller
+// knows it passed and that nothing it is judged by changed.
 struct Judged {
   std::vector<char> failing;       // per triangle, after the relaxation
   long failing_before_relax = 0;   // triangles failing as transported
   double seconds_judge = 0, seconds_relax = 0;
 };
 Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,
-                       const MeshingOptions& criteria);
+                       const MeshingOptions& criteria, const std::vector<char>* settled = nullptr);
 
 }  // namespace skinmesh::detail

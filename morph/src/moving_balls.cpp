@@ -119,7 +119,45 @@ Eigen::Matrix3d cell_rotation(const MixedCell& cell, const std::vector<Ball>& ol
   return Eigen::Quaterniond::FromTwoVectors(turned, after).toRotationMatrix() * r;
 }
 
-enum class VertexFate : char { moved, relocated, lost };
+// kept: in a cell the step left as it was (quiet_balls), where it stays.
+enum class VertexFate : char { kept, moved, relocated, lost };
+
+// Per ball, 1 where `flags` marks it and every neighbour it has in the
+// regular triangulation of `from` or of `to` (hidden: none).
+std::vector<char> with_all_neighbours(const SkinComplex& from, const SkinComplex& to, const std::vector<char>& flags) {
+  const auto neighbours_flagged = [&flags](const SkinComplex& c, size_t ball) {
+    const int cell = c.vertex_cell(static_cast<int>(ball));
+    if (cell < 0) return true;
+    for (auto it = c.cofaces_begin(cell); it != c.cofaces_end(cell); ++it)
+      if (!flags[static_cast<size_t>(it->ball)]) return false;
+    return true;
+  };
+  std::vector<char> out(flags.size(), 0);
+  for (size_t b = 0; b < out.size(); ++b) out[b] = flags[b] && neighbours_flagged(from, b) && neighbours_flagged(to, b);
+  return out;
+}
+
+// Per ball, whether the step left its mixed cells as they were: it and
+// every neighbour it has before or after the step kept centre and weight
+// exactly. The Voronoi face nu_X of a simplex X of such balls is the
+// intersection of the power halfspaces of X's neighbours against X, all of
+// them balls that stayed, so it is the same set before and after (and X a
+// simplex of both); so are its mixed cell (1-s) delta_X + s nu_X and the
+// skin's patch in it (docs/math.md section 3).
+std::vector<char> quiet_balls(const SkinComplex& from, const SkinComplex& to) {
+  const std::vector<Ball>& before = from.balls();
+  const std::vector<Ball>& after = to.balls();
+  std::vector<char> stayed(before.size(), 0);
+  for (size_t b = 0; b < stayed.size(); ++b)
+    stayed[b] = before[b].center == after[b].center && before[b].weight == after[b].weight;
+  return with_all_neighbours(from, to, stayed);
+}
+
+bool cell_of_flagged_balls(const MixedCell& cell, const std::vector<char>& flags) {
+  for (int i = 0; i <= cell.dim; ++i)
+    if (!flags[static_cast<size_t>(cell.balls[static_cast<size_t>(i)])]) return false;
+  return true;
+}
 
 // Where a vertex was before a step, and how far it may move in the step
 // and keep its id: the largest move of its cell's balls plus `continuity`
@@ -163,9 +201,13 @@ std::vector<Continuity> continuity_bounds(const SkinComplex& from, const SkinCom
 // map where the cell persists with a size of the same sign, else projected
 // from where its owning ball took it.
 VertexFate move_vertex(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
-                       Eigen::Vector3d& p, int& cell) {
+                       const std::vector<char>& quiet, Eigen::Vector3d& p, int& cell) {
   const MixedCell& c0 = from.cell(cell);
   const int persisting = to.find_cell(c0.balls);
+  if (persisting >= 0 && cell_of_flagged_balls(c0, quiet)) {
+    cell = persisting;
+    return VertexFate::kept;
+  }
   if (persisting >= 0) {
     const MixedCell& c1 = to.cell(persisting);
     const double ratio = c1.R2 / c0.R2;
@@ -401,10 +443,11 @@ struct MovingBalls::Impl {
   const MorphFrame& advance_to(std::vector<Ball> balls, double t);
   void step(std::vector<Ball> balls);
   void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
-              SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
-  std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved);
+              SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed, std::vector<char> settled);
+  std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved, const std::vector<char>& settled);
   std::string mend_locally(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
-                           SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed);
+                           SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed,
+                           std::vector<char> settled);
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
                      SurfaceMesh& moved, std::vector<char>& lost, long& euler_change);
   bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
@@ -418,6 +461,10 @@ struct MovingBalls::Impl {
   long next_id_ = 0;
   std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;  // detail::RefusedEdges
   std::function<void(SurfaceMesh&, std::vector<long>&)> certificate_fault_;  // tests only: none
+  // The last step ended with every triangle of the frame judged passing
+  // (mended locally, or nothing to mend), not remeshed: the settled
+  // triangles of the next step keep that verdict (step).
+  bool all_passed_ = false;
 };
 
 MovingBalls::Impl::Impl(std::vector<Ball> balls, const MovingOptions& options, double t) : options_(options) {
@@ -525,6 +572,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
   counting.run([&] { topology = skin_topology(next.balls()); });
   std::vector<int> critical = inside_critical_cells(next);
   const std::vector<Eigen::Matrix3d> rotations = neighbourhood_rotations(complex_, next.balls());
+  const std::vector<char> quiet = quiet_balls(complex_, next);
   s.seconds_complex += seconds_since(stage);
   stage = Clock::now();
   SurfaceMesh moved = frame_.mesh;
@@ -533,16 +581,23 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
   std::vector<VertexFate> fates(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
-      fates[v] = move_vertex(complex_, next, rotations, moved.vertices[v], moved.cells[v]);
-      if (fates[v] != VertexFate::lost)
+      fates[v] = move_vertex(complex_, next, rotations, quiet, moved.vertices[v], moved.cells[v]);
+      if (fates[v] == VertexFate::moved || fates[v] == VertexFate::relocated)
         moved.normals[v] = next.evaluate(moved.vertices[v], moved.cells[v]).gradient.normalized();
     }
   });
-  std::vector<char> lost(n, 0), stayed(n, 0);
+  // A triangle whose corners all stayed in cells two rings of stillness
+  // deep (with_all_neighbours of the quiet balls) sees the same skin around
+  // it as before, so it keeps the verdict it had: it passed, when the step
+  // before ended with every triangle judged passing.
+  const std::vector<char> settled_balls = with_all_neighbours(complex_, next, quiet);
+  std::vector<char> lost(n, 0), stayed(n, 0), settled(n, 0);
   for (size_t v = 0; v < n; ++v) {
     lost[v] = fates[v] == VertexFate::lost;
-    stayed[v] = fates[v] == VertexFate::moved;
-    s.moved += fates[v] == VertexFate::moved;
+    stayed[v] = fates[v] == VertexFate::moved || fates[v] == VertexFate::kept;
+    settled[v] = all_passed_ && fates[v] == VertexFate::kept &&
+                 cell_of_flagged_balls(next.cell(moved.cells[v]), settled_balls);
+    s.moved += stayed[v];
     s.relocated += fates[v] == VertexFate::relocated;
     s.lost += lost[v];
   }
@@ -553,7 +608,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
   stage = Clock::now();
   counting.wait();
   s.seconds_complex += seconds_since(stage);
-  repair(next, topology, critical, moved, lost, stayed);
+  repair(next, topology, critical, moved, lost, stayed, std::move(settled));
   // Ids mean continuous motion (moving_balls.hpp): a vertex that
   // moved farther in the step than its bound, by transport, relaxation,
   // an edit or a remesh, is another point of the skin and takes a new id.
@@ -574,8 +629,10 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
 // The moved step made the frame: kept as it is, or mended, cheapest first
 // (moving_balls.hpp); throws Error when no mesh of the step can be certified.
 void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
-                         SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed) {
-  const std::string because = mend_locally(next, topology, critical, moved, lost, stayed);
+                         SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed,
+                         std::vector<char> settled) {
+  const std::string because = mend_locally(next, topology, critical, moved, lost, stayed, std::move(settled));
+  all_passed_ = because.empty();
   if (because.empty()) return;
   FrameStats& s = frame_.stats;
   s.remeshed_because = because;
@@ -604,9 +661,14 @@ void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topo
 
 // Per triangle of `moved`, whether it fails the frame criteria, after the
 // corners of those that failed were relaxed along the skin once.
-std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved) {
-  detail::Judged j = detail::judge_and_relax(next, moved, options_.relaxation, options_.frames);
+std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved,
+                                                     const std::vector<char>& settled) {
+  detail::Judged j = detail::judge_and_relax(next, moved, options_.relaxation, options_.frames, &settled);
   FrameStats& s = frame_.stats;
+  if (settled.size() == moved.vertices.size())
+    for (const auto& t : moved.triangles)
+      s.settled += settled[static_cast<size_t>(t[0])] && settled[static_cast<size_t>(t[1])] &&
+                   settled[static_cast<size_t>(t[2])];
   s.bad_triangles += j.failing_before_relax;
   s.seconds_judge += j.seconds_judge;
   s.seconds_relax += j.seconds_relax;
@@ -619,7 +681,7 @@ std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, Su
 // vertices.
 std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinTopology& topology,
                                       const std::vector<int>& critical, SurfaceMesh& moved, std::vector<char>& lost,
-                                      const std::vector<char>& stayed) {
+                                      const std::vector<char>& stayed, std::vector<char> settled) {
   FrameStats& s = frame_.stats;
   // Where the topology changed; a component or void that vanished is
   // dropped first (its sphere of triangles has no skin left to go to); one
@@ -634,6 +696,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     keep_events(complex_, next, local, vanished);
   }  // otherwise the critical cells that came or went are flips and cancelling pairs: no place to remesh
   local.euler_change = topology.euler - topology_.euler;
+  if (!vanished.empty()) settled.clear();  // drop_vanished renumbers the vertices
   if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, local.euler_change))
     for (const detail::VanishingSphere& v : vanished) {  // not a component of its own: the patch takes it
       detail::TopologyChange change;
@@ -643,7 +706,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     }
   const long lost_count = std::count(lost.begin(), lost.end(), 1);
   if (lost_count > 0) return std::to_string(lost_count) + " vertices could not be put on the new skin";
-  std::vector<char> failing = judge_and_relax(next, moved);
+  std::vector<char> failing = judge_and_relax(next, moved, settled);
   long left = std::count(failing.begin(), failing.end(), 1);
   const auto stage = Clock::now();
   if (left > 0 && options_.repair.edits.enabled) {

@@ -5,6 +5,7 @@
 // motion; the certificate refusing a wrong mesh.
 #include "test_support.hpp"
 
+#include "judge.hpp"
 #include "mesh_part.hpp"
 
 #include "skinmesh/core/skin_complex.hpp"
@@ -235,6 +236,40 @@ TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every 
     if (k % 4 == 0) check_frame(moving, balls, 20.0);  // five values of t
     before = balls;
   }
+}
+
+TEST_CASE("moving balls: triangles where the step left the skin as it was keep their verdict unjudged", "[moving]") {
+  // Ubiquitin's last two residues turned a degree a frame about the CA
+  // atom before them: most of the skin is far from them and stays. Each frame is judged again in full, by
+  // the same judge over every triangle and the frame's own complex: a
+  // triangle taken as passing where the skin changed under it fails here.
+  const Molecule ubi = read_molecule(test::data_file("1ubi.pdb"));
+  const std::vector<Ball> start = balls_from_molecule(ubi, 0.5);
+  std::vector<char> strand(start.size(), 0);
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < ubi.atoms.size(); ++i) {
+    strand[i] = ubi.atoms[i].residue_number >= 75;
+    if (ubi.atoms[i].residue_number == 74 && ubi.atoms[i].name == "CA") pivot = ubi.atoms[i].position;
+  }
+  MovingOptions options;
+  // Ubiquitin is small: a patch's context reaches over half of it. Patches
+  // that large are taken, so that frames are mended locally, not remeshed.
+  options.repair.patch.max_sample_share = 0.9;
+  MovingBalls moving(start, options);
+  long settled_frames = 0;
+  for (int k = 1; k <= 6; ++k) {
+    const MorphFrame& f = moving.advance_to(hinged(start, strand, pivot, Eigen::Vector3d(0, 0, 1), 1.0 * k), k);
+    INFO("frame " << k << ": " << f.stats.settled << " of " << f.stats.triangles << " settled, remeshed "
+                   << f.stats.remeshed << " " << f.stats.remeshed_because);
+    CHECK(f.stats.settled < f.stats.triangles);  // the strand's skin changed
+    settled_frames += f.stats.settled > 0;
+    const std::vector<char> failing =
+        detail::failing_triangles(moving.complex(), f.mesh, f.mesh.triangles, options.frames);
+    CHECK(std::count(failing.begin(), failing.end(), 1) == 0);
+  }
+  // The first step follows the first frame, not judged at the frames'
+  // criteria; a frame remeshed whole is not judged either: the next judges all.
+  CHECK(settled_frames >= 3);
 }
 
 TEST_CASE("moving balls: atoms on one side only grow out of and shrink into their anchor", "[moving]") {
