@@ -212,6 +212,7 @@ nlohmann::json stats_json(const FrameStats& s) {
           {"removed", s.removed},
           {"steps", s.steps},
           {"reidentified", s.reidentified},
+          {"settled", s.settled},
           {"ids_kept", s.ids_kept},
           {"max_kept_move", s.max_kept_move},
           {"repaired", s.repaired},
