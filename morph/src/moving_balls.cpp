@@ -449,7 +449,7 @@ struct MovingBalls::Impl {
                            SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed,
                            std::vector<char> settled);
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
-                     SurfaceMesh& moved, std::vector<char>& lost, long& euler_change);
+                     SurfaceMesh& moved, std::vector<char>& lost, std::vector<char>& settled, long& euler_change);
   bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
   MeshingOptions repair_criteria() const { return options_.frames; }
 
@@ -696,8 +696,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     keep_events(complex_, next, local, vanished);
   }  // otherwise the critical cells that came or went are flips and cancelling pairs: no place to remesh
   local.euler_change = topology.euler - topology_.euler;
-  if (!vanished.empty()) settled.clear();  // drop_vanished renumbers the vertices
-  if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, local.euler_change))
+  if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, settled, local.euler_change))
     for (const detail::VanishingSphere& v : vanished) {  // not a component of its own: the patch takes it
       detail::TopologyChange change;
       change.point = v.center;
@@ -750,7 +749,8 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
 // `euler_change` gains 2 for each, since the repair counts from the mesh
 // without them. False when one is not found as a component of its own.
 bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
-                                SurfaceMesh& moved, std::vector<char>& lost, long& euler_change) {
+                                SurfaceMesh& moved, std::vector<char>& lost, std::vector<char>& settled,
+                                long& euler_change) {
   std::vector<char> found;
   const std::vector<char> gone =
       detail::vanishing_components(frame_.mesh, std::vector<char>(stayed.size(), 0), vanished, found);
@@ -760,13 +760,15 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
   std::vector<int> kept_from;
   moved = detail::used_part(moved, keep, kept_from);
   std::vector<long> ids;
-  std::vector<char> kept_lost;
+  std::vector<char> kept_lost, kept_settled;
   for (int v : kept_from) {
     ids.push_back(frame_.ids[static_cast<size_t>(v)]);
     kept_lost.push_back(lost[static_cast<size_t>(v)]);
+    kept_settled.push_back(settled.empty() ? 0 : settled[static_cast<size_t>(v)]);
   }
   frame_.ids = std::move(ids);
   lost = std::move(kept_lost);
+  settled = std::move(kept_settled);
   euler_change += 2 * static_cast<long>(vanished.size());
   return true;
 }
