@@ -258,11 +258,11 @@ bool star_is_disk(int v, const std::vector<Triangle>& around) {
 // The vertices of the mesh around which the seam fails: a patch vertex
 // whose triangles (kept ones plus the patch's) are not one disk, and the old
 // corners of the patch triangles around a new point whose star is not a
-// disk. Empty when the seam holds. New points are numbered from
-// mesh.vertices.size() on.
+// disk; such new points go to `open_new`. Empty when the seam holds. New
+// points are numbered from mesh.vertices.size() on.
 std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, const std::vector<char>& region,
                              const std::vector<Triangle>& fresh, const std::vector<signed char>& role,
-                             const std::vector<char>& drop) {
+                             const std::vector<char>& drop, std::vector<int>& open_new) {
   const size_t old_vertices = mesh.vertices.size();
   auto in_patch = [&](int v) {
     return static_cast<size_t>(v) >= old_vertices ||
@@ -284,6 +284,7 @@ std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, 
   for (const auto& [v, triangles] : around) {
     if (!in_patch(v) || star_is_disk(v, triangles)) continue;
     if (static_cast<size_t>(v) < old_vertices) faults.push_back(v);
+    else open_new.push_back(v);
     for (const Triangle& t : triangles)
       for (int w : t)
         if (static_cast<size_t>(w) < old_vertices) faults.push_back(w);
@@ -368,6 +369,37 @@ std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const PatchMeshRe
     if (!std::binary_search(kept_near.begin(), kept_near.end(), key)) out.push_back(g);
   }
   return out;
+}
+
+// Around the new points whose star is not a disk (seam_faults), the patch
+// and context vertices within `reach` times the star's longest edge, added
+// to `faults`: the missing triangles of such a star have a context corner
+// (PatchPolicy::open_star_reach).
+void add_near_open_stars(const SurfaceMesh& mesh, const std::vector<signed char>& role,
+                         const std::vector<SkinSample>& added, const std::vector<Triangle>& fresh,
+                         const std::vector<int>& open_new, double reach, std::vector<int>& faults) {
+  if (open_new.empty() || !(reach > 0)) return;
+  const size_t n = mesh.vertices.size();
+  auto at = [&](int v) -> const Eigen::Vector3d& {
+    const auto u = static_cast<size_t>(v);
+    return u < n ? mesh.vertices[u] : added[u - n].point;
+  };
+  std::unordered_map<int, double> longest;  // per open star's point
+  for (int v : open_new) longest[v] = 0;
+  for (const Triangle& t : fresh)
+    for (size_t k = 0; k < 3; ++k) {
+      const auto it = longest.find(t[k]);
+      if (it == longest.end()) continue;
+      it->second = std::max({it->second, (at(t[k]) - at(t[(k + 1) % 3])).norm(), (at(t[k]) - at(t[(k + 2) % 3])).norm()});
+    }
+  std::vector<int> near;  // the patch's and the context's vertices
+  for (size_t v = 0; v < n; ++v)
+    if (role[v] != kNone) near.push_back(static_cast<int>(v));
+  for (const auto& [v, edge] : longest) {
+    const double r2 = reach * reach * edge * edge;
+    for (int w : near)
+      if ((at(w) - at(v)).squaredNorm() < r2) faults.push_back(w);
+  }
 }
 
 // One attempt on `region`: the patch meshed, not yet in the mesh. Its new
@@ -458,7 +490,9 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   kept_near.erase(std::unique(kept_near.begin(), kept_near.end()), kept_near.end());
   a.fresh = patch_triangles(mesh, patch, index, kept_near);
   a.added = std::move(patch.added);
-  a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop);
+  std::vector<int> open_new;
+  a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop, open_new);
+  add_near_open_stars(mesh, role, a.added, a.fresh, open_new, options.policy.open_star_reach, a.faults);
   const std::vector<char> bad = failing_fresh(complex, mesh, a.added, a.fresh, accept);
   for (size_t f = 0; f < a.fresh.size(); ++f)
     if (bad[f])

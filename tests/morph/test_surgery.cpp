@@ -4,7 +4,7 @@
 // unless it has shrunk or its refusal has aged; and the local repair, which
 // leaves a patch that is nearly the whole frame to the whole-frame remesh
 // and, after an attempt with faults, meshes again only the pieces that had
-// them.
+// them and grows over the context near a new point whose star does not close.
 #include <catch2/catch.hpp>
 
 #include "test_support.hpp"
@@ -104,43 +104,77 @@ TEST_CASE("local repair: a patch that would take nearly every vertex is left to 
   CHECK(meshed.counts.patch_triangles == static_cast<long>(f.mesh.triangles.size()));
 }
 
-TEST_CASE("local repair: after an attempt with faults only the pieces that had them are meshed again", "[morph]") {
-  // Ubiquitin's last 32 atoms (the C-terminal strand) turned by 2 degrees
-  // about an atom at the strand's foot; each vertex projected onto the new
-  // skin from where its owning ball took it; the edits first, as a frame's
-  // repair does. What they leave is patched with and without retrying in pieces.
-  const std::vector<Ball> before = test::centred_model(test::data_file("1ubi.pdb"), 1);
-  constexpr size_t kStrand = 570;
-  REQUIRE(before.size() > kStrand);
-  std::vector<Ball> after = before;
-  const Eigen::Vector3d pivot = before[kStrand].center;
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  for (size_t i = kStrand; i < after.size(); ++i) after[i].center = pivot + turn * (before[i].center - pivot);
-  const SkinComplex from = build_skin_complex(before), to = build_skin_complex(after);
+namespace {
+
+// Ubiquitin's atoms from `first` on (the C-terminal strand and what
+// precedes it) turned by `degrees` about (1,2,3) through atom `first`;
+// each vertex of the mesh at 20 degrees projected onto the new skin from
+// where its owning ball took it; the edits first, as a frame's repair does.
+// What they leave is for the local patch.
+struct TurnedStrand {
+  std::vector<Ball> before, after;
+  SkinComplex to;
   MeshingOptions accept;
-  accept.min_angle = 20;
-  SkinMeshResult made = mesh_skin(from, accept);
+  detail::RepairResult edited;
+  detail::LocalRepairOptions options;
+};
+
+TurnedStrand turned_strand(size_t first, double degrees) {
+  TurnedStrand f;
+  f.before = test::centred_model(test::data_file("1ubi.pdb"), 1);
+  REQUIRE(f.before.size() > first);
+  f.after = f.before;
+  const Eigen::Vector3d pivot = f.before[first].center;
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(degrees * M_PI / 180, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (size_t i = first; i < f.after.size(); ++i) f.after[i].center = pivot + turn * (f.before[i].center - pivot);
+  const SkinComplex from = build_skin_complex(f.before);
+  f.to = build_skin_complex(f.after);
+  f.accept.min_angle = 20;
+  SkinMeshResult made = mesh_skin(from, f.accept);
   REQUIRE(made.status == MeshingStatus::ok);
   SurfaceMesh moved = made.mesh;
   for (size_t v = 0; v < moved.vertices.size(); ++v) {
     const int owner = from.owning_ball(moved.vertices[v], moved.cells[v]);
     const auto b = static_cast<size_t>(owner);
-    Eigen::Vector3d offset = moved.vertices[v] - before[b].center;
-    if (b >= kStrand) offset = turn * offset;
-    const Projection p = to.project(after[b].center + offset, to.vertex_cell(owner), 1e-14);
+    Eigen::Vector3d offset = moved.vertices[v] - f.before[b].center;
+    if (b >= first) offset = turn * offset;
+    const Projection p = f.to.project(f.after[b].center + offset, f.to.vertex_cell(owner), 1e-14);
     REQUIRE(p.converged);
     moved.vertices[v] = p.point;
     moved.cells[v] = p.cell;
-    moved.normals[v] = to.evaluate(p.point, p.cell).gradient.normalized();
+    moved.normals[v] = f.to.evaluate(p.point, p.cell).gradient.normalized();
   }
-  const std::vector<char> failing = detail::failing_triangles(to, moved, moved.triangles, accept);
-  const detail::RepairResult edited = detail::mend_by_edits(to, moved, failing, accept, EditPolicy{});
-  REQUIRE(edited.left > 0);
-  detail::LocalRepairOptions options;
-  options.euler_change = skin_topology(after).euler - skin_topology(before).euler;
+  const std::vector<char> failing = detail::failing_triangles(f.to, moved, moved.triangles, f.accept);
+  f.edited = detail::mend_by_edits(f.to, moved, failing, f.accept, EditPolicy{});
+  REQUIRE(f.edited.left > 0);
+  f.options.euler_change = skin_topology(f.after).euler - skin_topology(f.before).euler;
+  return f;
+}
+
+// The frame a patch made: every triangle passes the frame's criteria, and
+// the static mesher's guarantees hold by the independent check (on the skin
+// by the oracle, closed oriented manifold, no self-intersections, the
+// skin's topology).
+void check_patched(const TurnedStrand& f, const detail::RepairResult& patched) {
+  const std::vector<char> still = detail::failing_triangles(f.to, patched.mesh, patched.mesh.triangles, f.accept);
+  CHECK(std::count(still.begin(), still.end(), 1) == 0);
+  GuaranteeOptions guarantees;
+  guarantees.min_angle = 20;
+  guarantees.on_skin_tolerance = 1e-8;
+  const GuaranteeReport report = check_guarantees(patched.mesh, f.after, 0.5, guarantees);
+  CHECK(report.all_hold());
+}
+
+}  // namespace
+
+TEST_CASE("local repair: after an attempt with faults only the pieces that had them are meshed again", "[morph]") {
+  // The strand's last 32 atoms turned by 2 degrees, patched with and
+  // without retrying in pieces.
+  TurnedStrand f = turned_strand(570, 2);
   auto patch = [&](bool in_pieces) {
-    options.policy.retry_in_pieces = in_pieces;
-    return detail::repair_locally(to, edited.mesh, edited.failing, accept, accept, options);
+    f.options.policy.retry_in_pieces = in_pieces;
+    return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
   };
   const detail::RepairResult whole = patch(false), pieces = patch(true);
   REQUIRE(whole.ok);
@@ -149,24 +183,32 @@ TEST_CASE("local repair: after an attempt with faults only the pieces that had t
   CHECK(pieces.failed_because.empty());
   // Later attempts mesh only what had faults: fewer triangles in all.
   CHECK(pieces.attempted_triangles < whole.attempted_triangles);
-  // The frame the pieces made: every triangle passes the frame's criteria,
-  // and the static mesher's guarantees hold by the independent check (on
-  // the skin by the oracle, closed oriented manifold, no self-intersections,
-  // the skin's topology).
-  const std::vector<char> still = detail::failing_triangles(to, pieces.mesh, pieces.mesh.triangles, accept);
-  CHECK(std::count(still.begin(), still.end(), 1) == 0);
-  GuaranteeOptions guarantees;
-  guarantees.min_angle = 20;
-  guarantees.on_skin_tolerance = 1e-8;
-  const GuaranteeReport report = check_guarantees(pieces.mesh, after, 0.5, guarantees);
-  CHECK(report.all_hold());
+  check_patched(f, pieces);
   // A kept vertex stays where it was.
   REQUIRE(pieces.origin.size() == pieces.mesh.vertices.size());
   long kept = 0;
   for (size_t v = 0; v < pieces.origin.size(); ++v)
     if (pieces.origin[v] >= 0) {
       ++kept;
-      CHECK(pieces.mesh.vertices[v] == edited.mesh.vertices[static_cast<size_t>(pieces.origin[v])]);
+      CHECK(pieces.mesh.vertices[v] == f.edited.mesh.vertices[static_cast<size_t>(pieces.origin[v])]);
     }
   CHECK(kept > 0);
+}
+
+TEST_CASE("local repair: a new point whose star does not close grows the patch over the context near it", "[morph]") {
+  // The last 42 atoms turned by 25 degrees: a new point near the patch's
+  // rim misses triangles whose third corner is context, and growing around
+  // the star's own corners never reaches that context.
+  TurnedStrand f = turned_strand(560, 25);
+  f.options.policy.max_sample_share = 2;  // no bound: the patch may take most of the frame
+  auto patch = [&](double reach) {
+    f.options.policy.open_star_reach = reach;
+    return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
+  };
+  const detail::RepairResult corners_only = patch(0);
+  CHECK_FALSE(corners_only.ok);
+  CHECK(corners_only.failed_because.find("seam") != std::string::npos);
+  const detail::RepairResult grown = patch(PatchPolicy{}.open_star_reach);
+  REQUIRE(grown.ok);
+  check_patched(f, grown);
 }

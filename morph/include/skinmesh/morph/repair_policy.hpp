@@ -67,6 +67,13 @@ struct PatchPolicy {
   // bench_moving's 3mht motions at 101 frames 2 left 4 and 15 frames
   // remeshed whole instead of 13 and 18.
   double stalled_reach_scale = 2.0;
+  // A point the patch's refinement inserted whose star does not close
+  // lacks triangles whose third corner is context (the patch keeps only
+  // triangles among its own vertices), and growing the patch around the
+  // star's corners does not reach that context. The patch grows over the
+  // patch and context vertices within this times the star's longest edge
+  // instead (dimensionless; 0: around the star's corners only).
+  double open_star_reach = 2.0;
   // A patch whose samples (with their context) pass this share of the
   // frame's vertices is not tried (a share, 0-1): it is nearly the whole
   // frame, which the whole-frame remesh does once, where a patch may be
