@@ -82,6 +82,24 @@ std::vector<Ball> hinged(std::vector<Ball> balls, const std::vector<char>& movin
   return balls;
 }
 
+// Ubiquitin's residues from `first` on, to be hinged about the CA atom of
+// the residue before them.
+struct UbiquitinTail {
+  std::vector<Ball> start;
+  std::vector<char> moving;
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+};
+
+UbiquitinTail ubiquitin_tail(int first) {
+  const Molecule ubi = read_molecule(test::data_file("1ubi.pdb"));
+  UbiquitinTail tail{balls_from_molecule(ubi, 0.5), std::vector<char>(ubi.atoms.size(), 0), Eigen::Vector3d::Zero()};
+  for (size_t i = 0; i < ubi.atoms.size(); ++i) {
+    tail.moving[i] = ubi.atoms[i].residue_number >= first;
+    if (ubi.atoms[i].residue_number == first - 1 && ubi.atoms[i].name == "CA") tail.pivot = ubi.atoms[i].position;
+  }
+  return tail;
+}
+
 }  // namespace
 
 TEST_CASE("skin topology from the alpha complex: shapes of known topology", "[moving][topology]") {
@@ -184,15 +202,10 @@ TEST_CASE("moving balls: the same balls again give the same frame", "[moving]") 
 }
 
 TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every frame checked", "[moving]") {
-  ReadOptions read;
-  const Molecule ubi = read_molecule(test::data_file("1ubi.pdb"), read);
-  const std::vector<Ball> start = balls_from_molecule(ubi, 0.5);
-  std::vector<char> strand(start.size(), 0);
-  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < ubi.atoms.size(); ++i) {
-    strand[i] = ubi.atoms[i].residue_number >= 66;
-    if (ubi.atoms[i].residue_number == 65 && ubi.atoms[i].name == "CA") pivot = ubi.atoms[i].position;
-  }
+  const UbiquitinTail tail = ubiquitin_tail(66);
+  const std::vector<Ball>& start = tail.start;
+  const std::vector<char>& strand = tail.moving;
+  const Eigen::Vector3d& pivot = tail.pivot;
   const Eigen::Vector3d axis(0, 0, 1);
   MovingOptions options;
   options.max_step = 1.0;  // one internal step a frame: the continuity bound below is the step's
@@ -240,25 +253,19 @@ TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every 
 
 TEST_CASE("moving balls: triangles where the step left the skin as it was keep their verdict unjudged", "[moving]") {
   // Ubiquitin's last two residues turned a degree a frame about the CA
-  // atom before them: most of the skin is far from them and stays. Each frame is judged again in full, by
-  // the same judge over every triangle and the frame's own complex: a
-  // triangle taken as passing where the skin changed under it fails here.
-  const Molecule ubi = read_molecule(test::data_file("1ubi.pdb"));
-  const std::vector<Ball> start = balls_from_molecule(ubi, 0.5);
-  std::vector<char> strand(start.size(), 0);
-  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < ubi.atoms.size(); ++i) {
-    strand[i] = ubi.atoms[i].residue_number >= 75;
-    if (ubi.atoms[i].residue_number == 74 && ubi.atoms[i].name == "CA") pivot = ubi.atoms[i].position;
-  }
+  // atom before them: most of the skin is far from them and stays. Each
+  // frame is judged again in full, by the same judge over every triangle
+  // and the frame's own complex: a triangle taken as passing where the skin
+  // changed under it fails here.
+  const UbiquitinTail tail = ubiquitin_tail(75);
   MovingOptions options;
   // Ubiquitin is small: a patch's context reaches over half of it. Patches
   // that large are taken, so that frames are mended locally, not remeshed.
   options.repair.patch.max_sample_share = 0.9;
-  MovingBalls moving(start, options);
+  MovingBalls moving(tail.start, options);
   long settled_frames = 0;
   for (int k = 1; k <= 6; ++k) {
-    const MorphFrame& f = moving.advance_to(hinged(start, strand, pivot, Eigen::Vector3d(0, 0, 1), 1.0 * k), k);
+    const MorphFrame& f = moving.advance_to(hinged(tail.start, tail.moving, tail.pivot, Eigen::Vector3d(0, 0, 1), 1.0 * k), k);
     INFO("frame " << k << ": " << f.stats.settled << " of " << f.stats.triangles << " settled, remeshed "
                    << f.stats.remeshed << " " << f.stats.remeshed_because);
     CHECK(f.stats.settled < f.stats.triangles);  // the strand's skin changed
