@@ -15,8 +15,11 @@
 // sqrt(R2_X(t1) / R2_X(t0)); where the cell is gone, turned flat or its
 // size changed sign, the vertex is projected onto the new skin.
 //
-// Then, cheapest first: triangles failing the frame criteria have their
-// corners relaxed along the skin, are mended by edits (split, flip,
+// Then every triangle is judged against the frame criteria; after a step
+// that ended with every triangle passing, a triangle whose corners sit in
+// skin this step left exactly as it was keeps that verdict unjudged
+// (FrameStats::settled; docs/math.md section 6). Cheapest first, the
+// failing triangles have their corners relaxed along the skin, are mended by edits (split, flip,
 // contraction), then by a local patch; a frame whose topology changed or
 // that still fails is remeshed whole from its vertices, and meshed from
 // scratch only when that fails. Every step's mesh is certified: its
