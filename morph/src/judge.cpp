@@ -39,7 +39,7 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
   return bad;
 }
 
-void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
+long rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
                    const MeshingOptions& criteria, std::vector<char>& failing) {
   if (failing.size() != mesh.triangles.size() || moved.size() != mesh.vertices.size())
     contract_error("rejudge_moved: verdicts or marks do not match the mesh");
@@ -54,6 +54,7 @@ void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
   }
   const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
   for (size_t k = 0; k < at.size(); ++k) failing[at[k]] = verdicts[k];
+  return static_cast<long>(at.size());
 }
 
 Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,
@@ -64,7 +65,7 @@ Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const Rela
     std::vector<char> unsettled(mesh.vertices.size());
     std::transform(settled->begin(), settled->end(), unsettled.begin(), [](char s) { return static_cast<char>(!s); });
     j.failing.assign(mesh.triangles.size(), 0);
-    rejudge_moved(complex, mesh, unsettled, criteria, j.failing);
+    j.settled = static_cast<long>(mesh.triangles.size()) - rejudge_moved(complex, mesh, unsettled, criteria, j.failing);
   } else {
     j.failing = failing_triangles(complex, mesh, mesh.triangles, criteria);
   }

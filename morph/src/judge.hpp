@@ -41,8 +41,9 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
 // `failing` (from failing_triangles on `mesh` before some of its vertices
 // moved) brought up to date: only the triangles with a corner marked in
 // `moved` are judged again. A verdict depends on its corners, the first
-// corner's cell and the complex alone, so the others keep theirs.
-void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
+// corner's cell and the complex alone, so the others keep theirs. Returns
+// how many were judged again.
+long rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
                    const MeshingOptions& criteria, std::vector<char>& failing);
 
 // A transported frame judged, with relaxation only where it is needed (the
@@ -56,6 +57,7 @@ void rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
 struct Judged {
   std::vector<char> failing;       // per triangle, after the relaxation
   long failing_before_relax = 0;   // triangles failing as transported
+  long settled = 0;                // triangles taken as passing unjudged (all corners settled)
   double seconds_judge = 0, seconds_relax = 0;
 };
 Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,

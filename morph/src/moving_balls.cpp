@@ -665,10 +665,7 @@ std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, Su
                                                      const std::vector<char>& settled) {
   detail::Judged j = detail::judge_and_relax(next, moved, options_.relaxation, options_.frames, &settled);
   FrameStats& s = frame_.stats;
-  if (settled.size() == moved.vertices.size())
-    for (const auto& t : moved.triangles)
-      s.settled += settled[static_cast<size_t>(t[0])] && settled[static_cast<size_t>(t[1])] &&
-                   settled[static_cast<size_t>(t[2])];
+  s.settled += j.settled;
   s.bad_triangles += j.failing_before_relax;
   s.seconds_judge += j.seconds_judge;
   s.seconds_relax += j.seconds_relax;
