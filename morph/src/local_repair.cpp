@@ -493,13 +493,16 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   std::vector<int> open_new;
   a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop, open_new);
   add_near_open_stars(mesh, role, a.added, a.fresh, open_new, options.policy.open_star_reach, a.faults);
+  const size_t seam = a.faults.size();
   const std::vector<char> bad = failing_fresh(complex, mesh, a.added, a.fresh, accept);
   for (size_t f = 0; f < a.fresh.size(); ++f)
     if (bad[f])
       for (int v : a.fresh[f])
         if (static_cast<size_t>(v) < mesh.vertices.size()) a.faults.push_back(v);
   if (!a.faults.empty())
-    a.failed_because = std::to_string(a.faults.size()) + " seam or criteria faults left after growing the patch";
+    a.failed_because = std::to_string(seam) + " seam faults and " +
+                       std::to_string(std::count(bad.begin(), bad.end(), 1)) +
+                       " new triangles failing the frame criteria left after growing the patch";
   return a;
 }
 

@@ -8,6 +8,7 @@
 #include "judge.hpp"
 #include "mesh_part.hpp"
 
+#include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/skin_topology.hpp"
@@ -277,6 +278,33 @@ TEST_CASE("moving balls: triangles where the step left the skin as it was keep t
   // The first step follows the first frame, not judged at the frames'
   // criteria; a frame remeshed whole is not judged either: the next judges all.
   CHECK(settled_frames >= 3);
+}
+
+TEST_CASE("moving balls: a patch's new triangles pass the frame judge next to necks about to pinch", "[moving]") {
+  // Half of ubiquitin's atoms (from index 300 on) turned 3 degrees a frame
+  // about an axis through atom 300, in steps of up to 0.5 A: steps that
+  // open and pinch necks where the halves meet. At frame 5 a patch's
+  // refinement made triangles whose Voronoi edge crossed the skin once
+  // where the judge's window about the circumcentre crosses it twice; the
+  // judge refused them, the patch could not change them, and the frame was
+  // remeshed whole. The patch's refinement now holds its facets to the
+  // judge's window.
+  std::vector<Ball> start = molecule_balls("1ubi.pdb");
+  centre_balls(start);
+  const size_t first = 300;
+  const Eigen::Vector3d pivot = start[first].center;
+  std::vector<char> moving(start.size(), 0);
+  std::fill(moving.begin() + static_cast<long>(first), moving.end(), 1);
+  MovingOptions options;
+  options.repair.patch.max_sample_share = 0.9;  // ubiquitin is small (as above)
+  MovingBalls engine(start, options);
+  for (int k = 1; k <= 5; ++k) {
+    const std::vector<Ball> balls = hinged(start, moving, pivot, Eigen::Vector3d(1, 2, 3), 3.0 * k);
+    const MorphFrame& f = engine.advance_to(balls, k);
+    INFO("frame " << k << ": remeshed " << f.stats.remeshed << " " << f.stats.remeshed_because);
+    CHECK(f.stats.remeshed_because.find("new triangles failing the frame criteria") == std::string::npos);
+    if (k == 5) check_frame(engine, balls, options.frames.min_angle);
+  }
 }
 
 TEST_CASE("moving balls: atoms on one side only grow out of and shrink into their anchor", "[moving]") {

@@ -152,6 +152,17 @@ FacetEval Refiner::evaluate(const FacetShape& shape) const {
   triangle.ball_cell = e.cell;
   triangle.crossings = e.crossings;
   e.defect = triangle_defect(complex_, triangle, options_);
+  // A patch's triangles become a morph frame's, which the frame judge holds
+  // to the skin crossed once within its window about the circumcentre
+  // (restricted_triangle, the tolerance as reach). The Voronoi edge can be
+  // shorter than that window: next to a neck about to pinch it crosses the
+  // skin once where the window crosses it twice. Such a facet is refined as
+  // a topology defect; kept, the judge refuses it, and growing the patch
+  // around it meshes it the same way again.
+  if (!roles_.empty() && e.defect == TriangleDefect::none) {
+    const auto judged = restricted_triangle(complex_, triangle.corners, options_.tolerance, e.cell);
+    if (!judged || judged->crossings != 1) e.defect = TriangleDefect::topology;
+  }
   return e;
 }
 
