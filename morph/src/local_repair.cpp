@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -109,21 +110,21 @@ constexpr int kAttemptsBeforeGivingUp = 4;
 // Without them the Voronoi edge of a patch facet runs on across the gap, its
 // restricted point lies on the other sheet, and refinement meshes that sheet
 // a second time: the repair fails (a wrong topology, or too many points)
-// and the whole frame is remeshed. Near: within twice `longest` (the
-// longest edge of the region's triangles, add_context), about the diameter
-// of a patch facet's surface Delaunay ball, and no farther than `cap` target
-// lengths at the patch vertex (infinite: no cap). False, with `role`
-// part-marked, as soon as the patch and its context pass `most` vertices.
+// and the whole frame is remeshed. Near: within twice `longest[v]` of patch
+// vertex v (an edge length of the region's triangles, add_context), about
+// the diameter of a patch facet's surface Delaunay ball, and no farther
+// than `cap` target lengths at v (infinite: no cap). `reach` gets that
+// distance per vertex (0 off the patch). False, with `role` part-marked, as
+// soon as the patch and its context pass `most` vertices.
 bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
-                        double longest, const MeshingOptions& criteria, double cap, size_t most,
-                        std::vector<signed char>& role) {
-  if (!(longest > 0)) return true;
+                        const std::vector<double>& longest, const MeshingOptions& criteria, double cap, size_t most,
+                        std::vector<signed char>& role, std::vector<double>& reach) {
   const auto context = static_cast<signed char>(PatchRole::context);
-  std::vector<double> reach(role.size(), 0.0);
+  reach.assign(role.size(), 0.0);
   std::vector<double> reaches;
   for (size_t v = 0; v < role.size(); ++v) {
-    if (role[v] == kNone || role[v] == context) continue;
-    reach[v] = 2 * longest;
+    if (role[v] == kNone || role[v] == context || !(longest[v] > 0)) continue;
+    reach[v] = 2 * longest[v];
     if (std::isfinite(cap))
       reach[v] = std::min(reach[v], cap * target_edge_length(complex, mesh.vertices[v], mesh.cells[v], criteria));
     reaches.push_back(reach[v]);
@@ -182,32 +183,77 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   return true;
 }
 
-// The context of a patch (add_nearby_context). One triangle that transport
-// stretched across a pinching neck is many target lengths long, and with
-// it as the measure the context of a large patch took most of the frame
-// (70-86% of the vertices of 3mht in bench_moving's DNA motion), each
-// attempt then costing about a remesh of the whole frame. Past a quarter
-// of the frame the reach is capped at six target lengths. A small patch
-// keeps the uncapped reach: on small molecules the far context is what
-// lets a stretched patch succeed. The measure is at least `at_least`: a
-// patch meshed again in pieces keeps the reach of the whole. Returns the
-// measure.
+// Per vertex of the region's triangles, the longest edge of those
+// triangles within `rings` rings of it (0 elsewhere).
+std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vector<char>& region, int rings) {
+  std::vector<double> longest(mesh.vertices.size(), 0.0);
+  for (size_t f = 0; f < region.size(); ++f) {
+    if (!region[f]) continue;
+    const Triangle& t = mesh.triangles[f];
+    double edge = 0;
+    for (size_t k = 0; k < 3; ++k)
+      edge = std::max(edge, (mesh.vertices[static_cast<size_t>(t[k])] -
+                             mesh.vertices[static_cast<size_t>(t[(k + 1) % 3])]).norm());
+    for (int v : t) longest[static_cast<size_t>(v)] = std::max(longest[static_cast<size_t>(v)], edge);
+  }
+  for (int r = 0; r < rings; ++r) {
+    std::vector<double> wider = longest;
+    for (size_t f = 0; f < region.size(); ++f) {
+      if (!region[f]) continue;
+      const Triangle& t = mesh.triangles[f];
+      const double most = std::max({longest[static_cast<size_t>(t[0])], longest[static_cast<size_t>(t[1])],
+                                    longest[static_cast<size_t>(t[2])]});
+      for (int v : t) wider[static_cast<size_t>(v)] = std::max(wider[static_cast<size_t>(v)], most);
+    }
+    longest.swap(wider);
+  }
+  return longest;
+}
+
+// The context of a patch (add_nearby_context), by one of two measures.
+// Whole: the longest edge of the region's triangles, at every patch vertex.
+// One triangle that transport stretched across a pinching neck is many
+// target lengths long, and with it as the measure the context of a large
+// patch took most of the frame (70-86% of the vertices of 3mht in
+// bench_moving's DNA motion), each attempt then costing about a remesh of
+// the whole frame. Past a quarter of the frame the reach is capped at six
+// target lengths. A small patch keeps the uncapped reach: on small
+// molecules the far context is what lets a stretched patch succeed. The
+// measure is at least `at_least`: a patch meshed again in pieces keeps the
+// reach of the whole. Local (`local_scale` > 0): at each patch vertex the
+// longest region edge within two rings of it, times `local_scale`; the
+// refinement is then held near the patch (mesh_patch's `within`: half the
+// reach at each vertex), where this context covers the skin. `reach` gets
+// the distance per vertex. Returns the largest measure.
 double add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
-                   const std::vector<char>& region, double at_least, const MeshingOptions& criteria,
-                   std::vector<signed char>& role) {
+                   const std::vector<char>& region, double at_least, double local_scale,
+                   const MeshingOptions& criteria, std::vector<signed char>& role, std::vector<double>& reach) {
   constexpr double kLargeShare = 0.25;       // of the frame's vertices
   constexpr double kCapInTargetLengths = 6;  // dimensionless
-  // A region of seeds alone (a newborn component) takes the mesh's longest edge.
-  double longest = std::max(longest_edge(mesh, region), at_least);
-  if (!(longest > 0)) longest = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
+  constexpr int kLocalRings = 2;
+  std::vector<double> longest;
+  double measure = 0;
+  if (local_scale > 0) {
+    longest = local_longest_edges(mesh, region, kLocalRings);
+    for (double& l : longest) l *= local_scale;
+    measure = *std::max_element(longest.begin(), longest.end());
+    for (size_t v = 0; v < role.size(); ++v)  // seeds on a newborn component have no edge yet
+      if (role[v] != kNone && !(longest[v] > 0)) longest[v] = measure;
+  }
+  if (!(measure > 0)) {
+    // A region of seeds alone (a newborn component) takes the mesh's longest edge.
+    measure = std::max(longest_edge(mesh, region), at_least);
+    if (!(measure > 0)) measure = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
+    longest.assign(mesh.vertices.size(), measure);
+  }
   const std::vector<signed char> patch = role;
   const auto large = static_cast<size_t>(kLargeShare * static_cast<double>(role.size()));
   if (add_nearby_context(complex, mesh, stars, longest, criteria, std::numeric_limits<double>::infinity(), large,
-                         role))
-    return longest;
+                         role, reach))
+    return measure;
   role = patch;  // the uncapped search stopped once it passed a quarter
-  add_nearby_context(complex, mesh, stars, longest, criteria, kCapInTargetLengths, SIZE_MAX, role);
-  return longest;
+  add_nearby_context(complex, mesh, stars, longest, criteria, kCapInTargetLengths, SIZE_MAX, role, reach);
+  return measure;
 }
 
 // Interior vertices crowded together along a patch edge: the later one goes.
@@ -412,7 +458,9 @@ struct Attempt {
   std::vector<int> faults;
   bool meshed = false;          // the refinement ended ok (faults may remain)
   bool stopped = false;         // the refinement stopped (stalled, over budget)
+  bool too_large = false;       // not tried: with its context, nearly the whole frame
   long own = 0;                 // the patch's own points (its samples, less the context)
+  long context = 0;             // its context vertices
   double reach_measure = 0;     // of its context (add_context), Angstrom
 };
 
@@ -445,6 +493,7 @@ std::vector<char> failing_fresh(const SkinComplex& complex, const SurfaceMesh& m
 struct SoFar {
   long own = 0, inserted = 0;
   double reach_measure = 0;  // Angstrom
+  double local_scale = 0;    // > 0: the context by the local measure, times this (add_context)
 };
 
 // `seeds`: the mesh's vertices in [first, second) that no triangle uses
@@ -456,7 +505,9 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   std::vector<signed char> role = vertex_roles(mesh, stars, region);
   for (size_t v = seeds.first; v < seeds.second; ++v)
     if (stars.empty(static_cast<int>(v))) role[v] = static_cast<signed char>(PatchRole::interior);
-  a.reach_measure = add_context(complex, mesh, stars, region, so_far.reach_measure, accept, role);
+  std::vector<double> reach;
+  a.reach_measure =
+      add_context(complex, mesh, stars, region, so_far.reach_measure, so_far.local_scale, accept, role, reach);
   const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, options.crowded_below);
   std::vector<PatchRole> roles;
   std::vector<int> index;
@@ -465,11 +516,16 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   if (static_cast<double>(samples.size()) > options.policy.max_sample_share * static_cast<double>(mesh.vertices.size())) {
     a.failed_because = "the patch took nearly the whole frame (" + std::to_string(samples.size()) + " of " +
                        std::to_string(mesh.vertices.size()) + " vertices)";
+    a.too_large = true;
     return a;
   }
   a.own = std::count_if(roles.begin(), roles.end(), [](PatchRole r) { return r != PatchRole::context; });
+  a.context = static_cast<long>(samples.size()) - a.own;
   const long budget = 2 * (so_far.own + a.own) + 64 - so_far.inserted;
-  PatchMeshResult patch = mesh_patch(complex, samples, roles, repair, budget);
+  std::vector<double> within;  // a local context holds the refinement within half its reach
+  if (so_far.local_scale > 0)
+    for (int v : index) within.push_back(0.5 * reach[static_cast<size_t>(v)]);
+  PatchMeshResult patch = mesh_patch(complex, samples, roles, repair, budget, within);
   if (patch.status != MeshingStatus::ok) {  // no faults: growing would not help
     a.stopped = true;
     a.failed_because = std::string("the patch's refinement ended ") + meshing_status_name(patch.status) + " (" +
@@ -655,12 +711,14 @@ enum class Retry { pieces, whole };
 struct PiecesFailure {
   bool put_in = false;       // some attempt put pieces in the mesh
   bool ran_away = false;     // the last attempt's refinement stopped (stalled, over budget)
+  bool too_large = false;    // the patch with its context took nearly the whole frame
 };
 
 // The attempts on one patch.
 RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                             const MeshingOptions& repair, const MeshingOptions& accept,
-                            const LocalRepairOptions& options, Retry retry, PiecesFailure& failure) {
+                            const LocalRepairOptions& options, Retry retry, double local_scale,
+                            PiecesFailure& failure) {
   RepairResult out;
   // The frame as the patch's pieces go into it, with seeds on newborn components.
   SurfaceMesh mesh = with_birth_seeds(complex, given, options.changes);
@@ -672,17 +730,22 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
   size_t fewest = SIZE_MAX;  // the fewest faults an attempt left
   int since_fewest = 0;
   SoFar so_far;
+  so_far.local_scale = local_scale;
   bool widened = false;
   for (int attempt = 0; attempt < options.policy.attempts; ++attempt) {
     ++out.attempts;
     out.attempted_triangles += std::count(region.begin(), region.end(), 1);
     const Attempt a = try_patch(complex, mesh, *stars, region, seeds, so_far, repair, accept, options);
+    out.context_vertices += a.context;
     so_far.reach_measure = std::max(so_far.reach_measure, a.reach_measure);
     // A refinement that stalls is most often meshing the far side of a thin
     // gap its context missed: the same region once more, reaching farther.
     if (a.stopped && !widened && options.policy.stalled_reach_scale > 1) {
       widened = true;
-      so_far.reach_measure = options.policy.stalled_reach_scale * a.reach_measure;
+      if (so_far.local_scale > 0)
+        so_far.local_scale *= options.policy.stalled_reach_scale;
+      else
+        so_far.reach_measure = options.policy.stalled_reach_scale * a.reach_measure;
       out.failed_because = a.failed_because;  // should this have been the last attempt
       failure.ran_away = true;
       continue;
@@ -691,6 +754,7 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
     if (!a.meshed) {  // no faults: growing would not help
       out.failed_because = a.failed_because;
       failure.ran_away = a.stopped;
+      failure.too_large = a.too_large;
       return out;
     }
     // The pieces that hold go in now (all of them when there are no
@@ -742,24 +806,43 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
   return out;
 }
 
-}  // namespace
-
 // Retrying only the pieces that did not hold is cheaper, but a piece alone
 // can fail where the whole region succeeds: its refinement runs away with
 // less of the patch around it. Then the whole region is tried as well. (A
 // patch in pieces that ends with faults or the wrong Euler characteristic
 // ended the same way whole on bench_moving's 3mht motions.)
+RepairResult whole_context_patch(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
+                                 const MeshingOptions& repair, const MeshingOptions& accept,
+                                 const LocalRepairOptions& options) {
+  PiecesFailure failure;
+  if (!options.policy.retry_in_pieces)
+    return patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, 0, failure);
+  RepairResult out = patch_attempts(complex, given, failing, repair, accept, options, Retry::pieces, 0, failure);
+  if (out.ok || !failure.put_in || !failure.ran_away) return out;
+  RepairResult whole = patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, 0, failure);
+  whole.attempts += out.attempts;
+  whole.attempted_triangles += out.attempted_triangles;
+  whole.context_vertices += out.context_vertices;
+  return whole;
+}
+
+}  // namespace
+
+// A local context first (PatchPolicy::local_context_first); when that
+// fails, the whole region's measure, which a larger context makes no
+// cheaper to fail.
 RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
+  if (!options.policy.local_context_first) return whole_context_patch(complex, given, failing, repair, accept, options);
   PiecesFailure failure;
-  if (!options.policy.retry_in_pieces)
-    return patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, failure);
-  RepairResult out = patch_attempts(complex, given, failing, repair, accept, options, Retry::pieces, failure);
-  if (out.ok || !failure.put_in || !failure.ran_away) return out;
-  RepairResult whole = patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, failure);
-  whole.attempts += out.attempts;
-  whole.attempted_triangles += out.attempted_triangles;
+  const Retry retry = options.policy.retry_in_pieces ? Retry::pieces : Retry::whole;
+  RepairResult local = patch_attempts(complex, given, failing, repair, accept, options, retry, 1.0, failure);
+  if (local.ok || failure.too_large) return local;
+  RepairResult whole = whole_context_patch(complex, given, failing, repair, accept, options);
+  whole.attempts += local.attempts;
+  whole.context_vertices += local.context_vertices;
+  whole.attempted_triangles += local.attempted_triangles;
   return whole;
 }
 

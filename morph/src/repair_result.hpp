@@ -29,6 +29,7 @@ struct RepairResult {
   long thin_tried = 0;         // edits: edges thinning tried to contract
   long attempts = 0;           // local patch: attempts made (with a second round whole, both rounds')
   long attempted_triangles = 0;  // local patch: triangles of the region each attempt remeshed, summed
+  long context_vertices = 0;     // local patch: context vertices each attempt's refinement held, summed
   RepairCounts counts;
 };
 

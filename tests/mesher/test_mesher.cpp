@@ -479,3 +479,50 @@ TEST_CASE("mesh_patch: a patch that needs more than twice its own points stops, 
   CHECK(!mended.triangles.empty());
   for (const SkinSample& p : mended.added) CHECK(p.point.z() > -1.0);
 }
+
+TEST_CASE("mesh_patch: a patch whose context covers only the skin near it stays near it when held within a distance",
+          "[mesher][patch]") {
+  // One sphere of skin radius 14 A at edge length 1 A; the cap above
+  // z = 6 is the patch and the band 5.7 < z <= 6 below it its only context:
+  // the rest of the sphere has no sample. A facet of rim vertices spanning
+  // the cap then has a Voronoi edge that runs down through the empty
+  // sphere to its far side.
+  const std::vector<Ball> balls{ball(0, 0, 0, 14.0)};
+  const SkinComplex complex = build_skin_complex(balls, {0.5});
+  MeshingOptions options;
+  options.min_angle = 20.0;
+  options.edge_length = 1.0;
+  const SkinMeshResult sphere = mesh_skin(complex, options);
+  REQUIRE(sphere.status == MeshingStatus::ok);
+  const CapPatch cap = cap_patch(sphere.mesh, 6.0, 1);
+  CapPatch banded;
+  for (size_t k = 0; k < cap.samples.size(); ++k)
+    if (cap.roles[k] != PatchRole::context || cap.samples[k].point.z() > 5.7) {
+      banded.samples.push_back(cap.samples[k]);
+      banded.roles.push_back(cap.roles[k]);
+    }
+  // Without a bound the refinement runs on over the far side of the sphere
+  // until it passes its budget.
+  const PatchMeshResult unbounded = mesh_patch(complex, banded.samples, banded.roles, options);
+  CHECK(unbounded.status == MeshingStatus::stalled);
+  // Held within 1.5 A of the patch's samples it meshes the cap.
+  const std::vector<double> within(banded.samples.size(), 1.5);
+  const PatchMeshResult held = mesh_patch(complex, banded.samples, banded.roles, options, 0, within);
+  INFO(held.message);
+  REQUIRE(held.status == MeshingStatus::ok);
+  CHECK(!held.added.empty());
+  for (const SkinSample& p : held.added) {
+    double nearest = INFINITY;
+    for (size_t k = 0; k < banded.samples.size(); ++k)
+      if (banded.roles[k] != PatchRole::context) nearest = std::min(nearest, (p.point - banded.samples[k].point).norm());
+    CHECK(nearest < 1.5);
+  }
+  // Its triangles cover the cap: every given interior vertex has a disk of them.
+  std::vector<int> around(banded.samples.size() + held.added.size(), 0);
+  for (const auto& t : held.triangles)
+    for (long v : t) ++around[static_cast<size_t>(v)];
+  for (size_t k = 0; k < banded.samples.size(); ++k)
+    if (banded.roles[k] == PatchRole::interior) CHECK(around[k] >= 3);
+  CHECK_THROWS_AS(mesh_patch(complex, banded.samples, banded.roles, options, 0, std::vector<double>(3, 1.0)),
+                  ContractError);
+}

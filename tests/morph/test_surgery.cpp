@@ -212,3 +212,22 @@ TEST_CASE("local repair: a new point whose star does not close grows the patch o
   REQUIRE(grown.ok);
   check_patched(f, grown);
 }
+
+TEST_CASE("local repair: a patch first takes a context near each of its vertices", "[morph]") {
+  // The strand's last 32 atoms turned by 2 degrees (as above). The region's
+  // longest edge, the measure of the whole-region context, is longer than
+  // its edges near most of its vertices: the local context is smaller, the
+  // patch with it succeeds, and the frame it makes holds the guarantees.
+  TurnedStrand f = turned_strand(570, 2);
+  auto patch = [&](bool local_first) {
+    f.options.policy.local_context_first = local_first;
+    return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
+  };
+  const detail::RepairResult whole = patch(false), local = patch(true);
+  REQUIRE(whole.ok);
+  REQUIRE(local.ok);
+  INFO("context vertices: local " << local.context_vertices << " over " << local.attempts << " attempts, whole "
+                                  << whole.context_vertices << " over " << whole.attempts);
+  CHECK(local.context_vertices * whole.attempts < whole.context_vertices * local.attempts);
+  check_patched(f, local);
+}

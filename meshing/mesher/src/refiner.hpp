@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -222,7 +223,7 @@ class Refiner {
   SkinMeshResult run(const std::vector<SkinSample>* samples = nullptr);
   // mesh_patch: the samples with their roles, refined where patch facets fail.
   PatchMeshResult run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles,
-                            long least_budget = 0);
+                            long least_budget, const std::vector<double>& within);
 
  private:
   // Calls visit(facet, key) once for every finite facet with a vertex in
@@ -347,6 +348,20 @@ class Refiner {
   int sample_ids_ = 0;  // ids below this are the given samples' indices (remesh_skin, mesh_patch)
   std::vector<int> star_slot_;  // by vertex id: its place in repair_stars' list, else -1
   std::vector<PatchRole> roles_;  // by sample id (mesh_patch); empty for the whole skin
+  // Patch mode with `within` (mesh_patch): the patch samples, each with the
+  // distance from it a facet's skin crossing may lie, in a grid of cells as
+  // wide as the largest such distance. Empty: no bound.
+  struct NearPatch {
+    double cell = 0;
+    std::unordered_map<int64_t, std::vector<std::pair<Eigen::Vector3d, double>>> grid;
+    static int64_t key(const Eigen::Vector3i& c) {
+      return (int64_t{c.x()} & 0x1FFFFF) | ((int64_t{c.y()} & 0x1FFFFF) << 21) | ((int64_t{c.z()} & 0x1FFFFF) << 42);
+    }
+    Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const { return (p / cell).array().floor().cast<int>(); }
+    bool empty() const { return grid.empty(); }
+    bool near(const Eigen::Vector3d& p) const;
+  };
+  NearPatch near_patch_;
   long patch_budget_ = 0;         // insertions a patch may make (mesh_patch)
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();

@@ -51,8 +51,17 @@ std::optional<DualEdge> Refiner::dual_edge(const FacetShape& shape, const Eigen:
   // Beyond a convex hull facet the Voronoi edge is a ray leaving the hull.
   const double lambda_n = edge.apex_n ? end_parameter(*edge.apex_n)
                                       : (normal.dot(edge.apex_c - circumcenter) > 0 ? -reach : reach);
-  edge.a = circumcenter + std::min(lambda_c, lambda_n) * normal;
-  edge.b = circumcenter + std::max(lambda_c, lambda_n) * normal;
+  double from = std::min(lambda_c, lambda_n), to = std::max(lambda_c, lambda_n);
+  if (!near_patch_.empty()) {
+    // A patch whose context covers only the skin near it (mesh_patch's
+    // `within`) looks along the edge no farther than twice the circumradius:
+    // a crossing beyond is skin the context does not hold.
+    const double window = 2 * std::sqrt(circumradius2);
+    from = std::max(from, -window);
+    to = std::max(from, std::min(to, window));
+  }
+  edge.a = circumcenter + from * normal;
+  edge.b = circumcenter + to * normal;
   const double flat = 1e-3 * std::sqrt(circumradius2);
   edge.well_conditioned = edge.apex_n && std::abs(normal.dot(edge.apex_c - circumcenter)) > flat &&
                           std::abs(normal.dot(*edge.apex_n - circumcenter)) > flat;
@@ -128,6 +137,15 @@ FacetEval Refiner::evaluate(const FacetShape& shape) const {
                                      (edge->apex_n && (h.point - *edge->apex_n).squaredNorm() < r2);
                             }),
              hits.end());
+  // A patch held to `within` (mesh_patch) takes no facet whose crossings
+  // all lie far from its samples, and inserts only near them: refinement
+  // stays where the context covers the skin around it.
+  thread_local std::vector<char> near;
+  near.assign(hits.size(), 1);
+  if (!near_patch_.empty()) {
+    for (size_t k = 0; k < hits.size(); ++k) near[k] = near_patch_.near(hits[k].point);
+    if (std::find(near.begin(), near.end(), 1) == near.end()) hits.clear();
+  }
   e.crossings = static_cast<int>(hits.size());
   if (hits.empty()) return e;
   // The surface Delaunay ball: of several crossings, the largest.
@@ -135,7 +153,7 @@ FacetEval Refiner::evaluate(const FacetShape& shape) const {
   double best_r2 = -1;
   for (size_t k = 0; k < hits.size(); ++k) {
     const double r2 = (hits[k].point - p0).squaredNorm();
-    if (r2 > best_r2) {
+    if (near[k] && r2 > best_r2) {
       best_r2 = r2;
       best = k;
     }
@@ -1044,10 +1062,33 @@ SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
   return result;
 }
 
+bool Refiner::NearPatch::near(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3i c = cell_of(p);
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k) {
+        const auto it = grid.find(key(c + Eigen::Vector3i(i, j, k)));
+        if (it == grid.end()) continue;
+        for (const auto& [q, reach] : it->second)
+          if ((q - p).squaredNorm() < reach * reach) return true;
+      }
+  return false;
+}
+
 PatchMeshResult Refiner::run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles,
-                                   long least_budget) {
+                                   long least_budget, const std::vector<double>& within) {
   const auto start = Clock::now();
   roles_ = roles;
+  near_patch_ = NearPatch{};
+  if (!within.empty()) {
+    for (size_t i = 0; i < samples.size(); ++i)
+      if (roles[i] != PatchRole::context) near_patch_.cell = std::max(near_patch_.cell, within[i]);
+    if (near_patch_.cell > 0)
+      for (size_t i = 0; i < samples.size(); ++i)
+        if (roles[i] != PatchRole::context && within[i] > 0)
+          near_patch_.grid[near_patch_.key(near_patch_.cell_of(samples[i].point))].emplace_back(samples[i].point,
+                                                                                                  within[i]);
+  }
   const long own = std::count_if(roles.begin(), roles.end(), [](PatchRole r) { return r != PatchRole::context; });
   patch_budget_ = std::max(2 * own + 64, least_budget);
   insert_samples(samples);
@@ -1244,15 +1285,18 @@ SkinMeshResult remesh_skin(const SkinComplex& complex, const std::vector<SkinSam
 }
 
 PatchMeshResult mesh_patch(const SkinComplex& complex, const std::vector<SkinSample>& samples,
-                           const std::vector<PatchRole>& roles, const MeshingOptions& options, long least_budget) {
+                           const std::vector<PatchRole>& roles, const MeshingOptions& options, long least_budget,
+                           const std::vector<double>& within) {
   check_options(options);
   if (roles.size() != samples.size()) contract_error("mesh_patch: one role per sample");
+  if (!within.empty() && within.size() != samples.size())
+    contract_error("mesh_patch: one distance per sample in `within`, or none");
   std::optional<tbb::global_control> threads;
   if (options.threads > 0)
     threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(options.threads));
   detail::Refiner refiner(complex, options);
   try {
-    return refiner.run_patch(samples, roles, least_budget);
+    return refiner.run_patch(samples, roles, least_budget, within);
   } catch (const detail::RefinementStopped& stop) {
     PatchMeshResult result;
     result.status = stop.status;

@@ -81,6 +81,16 @@ struct PatchPolicy {
   // of a third to a half of the frame, which often succeed cheaply there;
   // moving atoms take 0.3 (moving_balls.hpp).
   double max_sample_share = 0.9;
+  // A patch is first tried with a local context: at each patch vertex the
+  // mesh vertices within twice the longest region edge within two rings of
+  // it, and the refinement held within half that distance of the patch
+  // (mesh_patch's `within`), so that it cannot run into skin the context
+  // does not hold. When that fails (not for want of room: a larger context
+  // would not fit either), the patch is tried again with the region's
+  // longest edge as the measure at every vertex. false: only the latter.
+  // A region with one stretched triangle otherwise takes a context of tens
+  // of thousands of vertices for a few hundred of its own.
+  bool local_context_first = true;
 };
 
 struct RepairPolicy {

@@ -224,8 +224,15 @@ struct PatchMeshResult {
 // twice the patch's own points (its context not counted) plus 64, or more
 // than `least_budget` points when that is larger: a caller that meshes a
 // patch again in pieces keeps the budget the whole patch had.
+// `within` (Angstrom, one per sample, context samples' unused; empty: no
+// bound) keeps the refinement near the patch when the context covers only
+// the skin near it: a facet counts only where its Voronoi edge, looked at
+// within twice the facet's circumradius of it, crosses the skin within
+// within[i] of a patch sample i. Without it, the context must cover the
+// skin any patch facet's Voronoi edge can reach, or refinement runs on
+// into skin the rest of the mesh covers.
 PatchMeshResult mesh_patch(const SkinComplex& complex, const std::vector<SkinSample>& samples,
                            const std::vector<PatchRole>& roles, const MeshingOptions& options = {},
-                           long least_budget = 0);
+                           long least_budget = 0, const std::vector<double>& within = {});
 
 }  // namespace skinmesh
