@@ -439,16 +439,28 @@ CapPatch cap_patch(const SurfaceMesh& mesh, double z0, size_t keep) {
   return p;
 }
 
+// One sphere of skin radius 14 A meshed at 20 degrees and edge length 1 A:
+// about 2,900 vertices.
+struct MeshedSphere {
+  SkinComplex complex;
+  MeshingOptions options;
+  SkinMeshResult mesh;
+};
+MeshedSphere meshed_sphere() {
+  MeshedSphere m{build_skin_complex({ball(0, 0, 0, 14.0)}, {0.5}), MeshingOptions{}, SkinMeshResult{}};
+  m.options.min_angle = 20.0;
+  m.options.edge_length = 1.0;
+  m.mesh = mesh_skin(m.complex, m.options);
+  REQUIRE(m.mesh.status == MeshingStatus::ok);
+  return m;
+}
+
 TEST_CASE("mesh_patch: a patch that needs more than twice its own points stops, however much context it has",
           "[mesher][patch]") {
-  // One sphere of skin radius 14 A at edge length 1 A: about 2,900 vertices.
-  const std::vector<Ball> balls{ball(0, 0, 0, 14.0)};
-  const SkinComplex complex = build_skin_complex(balls, {0.5});
-  MeshingOptions options;
-  options.min_angle = 20.0;
-  options.edge_length = 1.0;
-  const SkinMeshResult sphere = mesh_skin(complex, options);
-  REQUIRE(sphere.status == MeshingStatus::ok);
+  const MeshedSphere meshed = meshed_sphere();
+  const SkinComplex& complex = meshed.complex;
+  const MeshingOptions& options = meshed.options;
+  const SkinMeshResult& sphere = meshed.mesh;
   // The cap above z = 0, one interior vertex in 20 given: it needs far more
   // points than twice its own, but fewer than twice its context.
   const CapPatch sparse = cap_patch(sphere.mesh, 0.0, 20);
@@ -482,19 +494,14 @@ TEST_CASE("mesh_patch: a patch that needs more than twice its own points stops, 
 
 TEST_CASE("mesh_patch: a patch whose context covers only the skin near it stays near it when held within a distance",
           "[mesher][patch]") {
-  // One sphere of skin radius 14 A at edge length 1 A; the cap above
-  // z = 6 is the patch and the band 5.7 < z <= 6 below it its only context:
-  // the rest of the sphere has no sample. A facet of rim vertices spanning
-  // the cap then has a Voronoi edge that runs down through the empty
-  // sphere to its far side.
-  const std::vector<Ball> balls{ball(0, 0, 0, 14.0)};
-  const SkinComplex complex = build_skin_complex(balls, {0.5});
-  MeshingOptions options;
-  options.min_angle = 20.0;
-  options.edge_length = 1.0;
-  const SkinMeshResult sphere = mesh_skin(complex, options);
-  REQUIRE(sphere.status == MeshingStatus::ok);
-  const CapPatch cap = cap_patch(sphere.mesh, 6.0, 1);
+  // The sphere's cap above z = 6 is the patch and the band 5.7 < z <= 6
+  // below it its only context: the rest of the sphere has no sample. A
+  // facet of rim vertices spanning the cap then has a Voronoi edge that
+  // runs down through the empty sphere to its far side.
+  const MeshedSphere meshed = meshed_sphere();
+  const SkinComplex& complex = meshed.complex;
+  const MeshingOptions& options = meshed.options;
+  const CapPatch cap = cap_patch(meshed.mesh.mesh, 6.0, 1);
   CapPatch banded;
   for (size_t k = 0; k < cap.samples.size(); ++k)
     if (cap.roles[k] != PatchRole::context || cap.samples[k].point.z() > 5.7) {

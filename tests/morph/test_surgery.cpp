@@ -166,17 +166,21 @@ void check_patched(const TurnedStrand& f, const detail::RepairResult& patched) {
   CHECK(report.all_hold());
 }
 
+// The strand's edited mesh patched with one policy setting changed.
+template <class T>
+detail::RepairResult patched_with(TurnedStrand& f, T PatchPolicy::*setting, T value) {
+  f.options.policy.*setting = value;
+  return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
+}
+
 }  // namespace
 
 TEST_CASE("local repair: after an attempt with faults only the pieces that had them are meshed again", "[morph]") {
   // The strand's last 32 atoms turned by 2 degrees, patched with and
   // without retrying in pieces.
   TurnedStrand f = turned_strand(570, 2);
-  auto patch = [&](bool in_pieces) {
-    f.options.policy.retry_in_pieces = in_pieces;
-    return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
-  };
-  const detail::RepairResult whole = patch(false), pieces = patch(true);
+  const detail::RepairResult whole = patched_with(f, &PatchPolicy::retry_in_pieces, false);
+  const detail::RepairResult pieces = patched_with(f, &PatchPolicy::retry_in_pieces, true);
   REQUIRE(whole.ok);
   REQUIRE(whole.attempts >= 2);  // the frame needs a second attempt
   REQUIRE(pieces.ok);
@@ -201,14 +205,10 @@ TEST_CASE("local repair: a new point whose star does not close grows the patch o
   // the star's own corners never reaches that context.
   TurnedStrand f = turned_strand(560, 25);
   f.options.policy.max_sample_share = 2;  // no bound: the patch may take most of the frame
-  auto patch = [&](double reach) {
-    f.options.policy.open_star_reach = reach;
-    return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
-  };
-  const detail::RepairResult corners_only = patch(0);
+  const detail::RepairResult corners_only = patched_with(f, &PatchPolicy::open_star_reach, 0.0);
   CHECK_FALSE(corners_only.ok);
   CHECK(corners_only.failed_because.find("seam") != std::string::npos);
-  const detail::RepairResult grown = patch(PatchPolicy{}.open_star_reach);
+  const detail::RepairResult grown = patched_with(f, &PatchPolicy::open_star_reach, PatchPolicy{}.open_star_reach);
   REQUIRE(grown.ok);
   check_patched(f, grown);
 }
@@ -219,11 +219,8 @@ TEST_CASE("local repair: a patch first takes a context near each of its vertices
   // its edges near most of its vertices: the local context is smaller, the
   // patch with it succeeds, and the frame it makes holds the guarantees.
   TurnedStrand f = turned_strand(570, 2);
-  auto patch = [&](bool local_first) {
-    f.options.policy.local_context_first = local_first;
-    return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
-  };
-  const detail::RepairResult whole = patch(false), local = patch(true);
+  const detail::RepairResult whole = patched_with(f, &PatchPolicy::local_context_first, false);
+  const detail::RepairResult local = patched_with(f, &PatchPolicy::local_context_first, true);
   REQUIRE(whole.ok);
   REQUIRE(local.ok);
   INFO("context vertices: local " << local.context_vertices << " over " << local.attempts << " attempts, whole "
