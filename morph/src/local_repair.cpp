@@ -8,7 +8,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -829,8 +828,8 @@ RepairResult whole_context_patch(const SkinComplex& complex, const SurfaceMesh& 
 }  // namespace
 
 // A local context first (PatchPolicy::local_context_first); when that
-// fails, the whole region's measure, which a larger context makes no
-// cheaper to fail.
+// fails, the whole region's measure, unless the local patch already took
+// nearly the whole frame (a larger context would too).
 RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
