@@ -65,10 +65,10 @@ struct MovingOptions {
   double first_size_margin = 0.85;  // the first frame refined to `first` with its sizes times this (room to move)
   // The largest move of a ball in one internal step (Angstrom): the centre's
   // move plus the change of its radius. A call moving balls farther is
-  // split into equal steps. A step's repairs cost less than twice those of
-  // a step half as long: at 21 frames (about 0.7 A a frame) 3mht's hinge
-  // motion took 24.6 s with steps of up to 1 A against 40 s with 0.5 A,
-  // its DNA motion 53 s against 73 s, with as many frames remeshed whole.
+  // split into equal steps. Fewer, longer steps cost less in all: each
+  // step pays for the complex, the transport and the judging of the whole
+  // mesh once, and its repairs grow less than its length
+  // (docs/benchmarks.md, moving atoms).
   double max_step = 1.0;
   // A vertex keeps its id across a step when it moved at most the largest
   // move of its cell's balls plus this times its longest mesh edge; one
