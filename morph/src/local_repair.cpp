@@ -1,4 +1,5 @@
 #include "local_repair.hpp"
+#include "skinmesh/core/point_grid.hpp"
 
 #include "judge.hpp"
 #include "mesh_part.hpp"
@@ -131,11 +132,7 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   if (reaches.empty()) return true;
   // Grid cells as wide as the median reach: most vertices search 27 cells.
   std::nth_element(reaches.begin(), reaches.begin() + static_cast<long>(reaches.size() / 2), reaches.end());
-  const double cell = reaches[reaches.size() / 2];
-  auto cell_of = [&](const Eigen::Vector3d& p) -> Eigen::Vector3i { return (p / cell).array().floor().cast<int>(); };
-  auto key = [](const Eigen::Vector3i& c) {  // 21 bits a coordinate
-    return (int64_t{c.x()} & 0x1FFFFF) | ((int64_t{c.y()} & 0x1FFFFF) << 21) | ((int64_t{c.z()} & 0x1FFFFF) << 42);
-  };
+  PointGrid<int> grid(reaches[reaches.size() / 2]);  // vertices outside the patch
   // Only vertices in the patch's bounding box grown by the longest reach
   // can be near it: the grid holds those, not the whole frame.
   Eigen::AlignedBox3d near_box;
@@ -147,12 +144,11 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
     }
   near_box.min().array() -= farthest;
   near_box.max().array() += farthest;
-  std::unordered_map<int64_t, std::vector<int>> grid;  // vertices outside the patch, by grid cell
   // A vertex no triangle uses (one an earlier part of the patch dropped) is no context.
   for (int v = 0; v < static_cast<int>(mesh.vertices.size()); ++v)
     if (role[static_cast<size_t>(v)] == kNone && near_box.contains(mesh.vertices[static_cast<size_t>(v)]) &&
         !stars.empty(v))
-      grid[key(cell_of(mesh.vertices[static_cast<size_t>(v)]))].push_back(v);
+      grid.insert(mesh.vertices[static_cast<size_t>(v)], v);
   size_t taken = static_cast<size_t>(std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; }));
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and the list could outgrow
@@ -160,23 +156,14 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   for (size_t v = 0; v < role.size(); ++v) {
     if (!(reach[v] > 0)) continue;
     const Eigen::Vector3d& p = mesh.vertices[v];
-    const auto mark = [&](const std::vector<int>& near) {
-      for (int w : near) {
-        signed char& r = role[static_cast<size_t>(w)];
-        if (r == kNone && (mesh.vertices[static_cast<size_t>(w)] - p).squaredNorm() < reach[v] * reach[v]) {
-          r = context;
-          ++taken;
-        }
+    grid.any_near(p, static_cast<int>(std::ceil(reach[v] / grid.cell())), [&](int w) {
+      signed char& r = role[static_cast<size_t>(w)];
+      if (r == kNone && (mesh.vertices[static_cast<size_t>(w)] - p).squaredNorm() < reach[v] * reach[v]) {
+        r = context;
+        ++taken;
       }
-    };
-    const int span = static_cast<int>(std::ceil(reach[v] / cell));
-    const Eigen::Vector3i c = cell_of(p);
-    for (int i = -span; i <= span; ++i)
-      for (int j = -span; j <= span; ++j)
-        for (int k = -span; k <= span; ++k) {
-          const auto it = grid.find(key(c + Eigen::Vector3i(i, j, k)));
-          if (it != grid.end()) mark(it->second);
-        }
+      return false;
+    });
     if (taken > most) return false;
   }
   return true;

@@ -6,6 +6,7 @@
 
 #include "skinmesh/mesher/skin_mesher.hpp"
 
+#include "skinmesh/core/point_grid.hpp"
 #include "skinmesh/core/stopwatch.hpp"
 
 #include "skin_seeds.hpp"
@@ -21,7 +22,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdint>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -349,19 +349,10 @@ class Refiner {
   std::vector<int> star_slot_;  // by vertex id: its place in repair_stars' list, else -1
   std::vector<PatchRole> roles_;  // by sample id (mesh_patch); empty for the whole skin
   // Patch mode with `within` (mesh_patch): the patch samples, each with the
-  // distance from it a facet's skin crossing may lie, in a grid of cells as
-  // wide as the largest such distance. Empty: no bound.
-  struct NearPatch {
-    double cell = 0;
-    std::unordered_map<int64_t, std::vector<std::pair<Eigen::Vector3d, double>>> grid;
-    static int64_t key(const Eigen::Vector3i& c) {
-      return (int64_t{c.x()} & 0x1FFFFF) | ((int64_t{c.y()} & 0x1FFFFF) << 21) | ((int64_t{c.z()} & 0x1FFFFF) << 42);
-    }
-    Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const { return (p / cell).array().floor().cast<int>(); }
-    bool empty() const { return grid.empty(); }
-    bool near(const Eigen::Vector3d& p) const;
-  };
-  NearPatch near_patch_;
+  // distance from it a facet's skin crossing may lie, in cells as wide as
+  // the largest such distance. Empty: no bound.
+  PointGrid<std::pair<Eigen::Vector3d, double>> near_patch_;
+  bool near_patch(const Eigen::Vector3d& p) const;
   long patch_budget_ = 0;         // insertions a patch may make (mesh_patch)
   MeshingStats stats_;
   Clock::time_point last_report_ = Clock::now();

@@ -143,7 +143,7 @@ FacetEval Refiner::evaluate(const FacetShape& shape) const {
   thread_local std::vector<char> near;
   near.assign(hits.size(), 1);
   if (!near_patch_.empty()) {
-    for (size_t k = 0; k < hits.size(); ++k) near[k] = near_patch_.near(hits[k].point);
+    for (size_t k = 0; k < hits.size(); ++k) near[k] = near_patch(hits[k].point);
     if (std::find(near.begin(), near.end(), 1) == near.end()) hits.clear();
   }
   e.crossings = static_cast<int>(hits.size());
@@ -1062,33 +1062,24 @@ SkinMeshResult Refiner::run(const std::vector<SkinSample>* samples) {
   return result;
 }
 
-bool Refiner::NearPatch::near(const Eigen::Vector3d& p) const {
-  const Eigen::Vector3i c = cell_of(p);
-  for (int i = -1; i <= 1; ++i)
-    for (int j = -1; j <= 1; ++j)
-      for (int k = -1; k <= 1; ++k) {
-        const auto it = grid.find(key(c + Eigen::Vector3i(i, j, k)));
-        if (it == grid.end()) continue;
-        for (const auto& [q, reach] : it->second)
-          if ((q - p).squaredNorm() < reach * reach) return true;
-      }
-  return false;
+bool Refiner::near_patch(const Eigen::Vector3d& p) const {
+  return near_patch_.any_near(p, 1, [&](const std::pair<Eigen::Vector3d, double>& sample) {
+    return (sample.first - p).squaredNorm() < sample.second * sample.second;
+  });
 }
 
 PatchMeshResult Refiner::run_patch(const std::vector<SkinSample>& samples, const std::vector<PatchRole>& roles,
                                    long least_budget, const std::vector<double>& within) {
   const auto start = Clock::now();
   roles_ = roles;
-  near_patch_ = NearPatch{};
-  if (!within.empty()) {
+  double widest = 0;
+  for (size_t i = 0; i < within.size(); ++i)
+    if (roles[i] != PatchRole::context) widest = std::max(widest, within[i]);
+  near_patch_ = decltype(near_patch_)(widest > 0 ? widest : 1.0);
+  if (widest > 0)
     for (size_t i = 0; i < samples.size(); ++i)
-      if (roles[i] != PatchRole::context) near_patch_.cell = std::max(near_patch_.cell, within[i]);
-    if (near_patch_.cell > 0)
-      for (size_t i = 0; i < samples.size(); ++i)
-        if (roles[i] != PatchRole::context && within[i] > 0)
-          near_patch_.grid[near_patch_.key(near_patch_.cell_of(samples[i].point))].emplace_back(samples[i].point,
-                                                                                                  within[i]);
-  }
+      if (roles[i] != PatchRole::context && within[i] > 0)
+        near_patch_.insert(samples[i].point, {samples[i].point, within[i]});
   const long own = std::count_if(roles.begin(), roles.end(), [](PatchRole r) { return r != PatchRole::context; });
   patch_budget_ = std::max(2 * own + 64, least_budget);
   insert_samples(samples);
