@@ -63,9 +63,12 @@ MatchedMotion match_motion(const Molecule& source, const std::vector<Ball>& sour
 std::vector<Ball> MatchedMotion::balls_at(double t) const {
   if (!(t >= 0 && t <= 1)) contract_error("MatchedMotion::balls_at: t must lie in [0,1]");
   std::vector<Ball> out(tracks.size());
+  // a + t (b - a), not (1 - t) a + t b: an atom that does not move stays
+  // where it is bit for bit, so that the engine finds the skin around it
+  // unchanged (moving_balls.hpp).
   const auto centre_at = [&](const Track& k) {
-    return ((1 - t) * source_balls[static_cast<size_t>(k.source)].center + t * target_balls[static_cast<size_t>(k.target)].center)
-        .eval();
+    const Eigen::Vector3d& a = source_balls[static_cast<size_t>(k.source)].center;
+    return (a + t * (target_balls[static_cast<size_t>(k.target)].center - a)).eval();
   };
   for (size_t i = 0; i < tracks.size(); ++i) {
     const Track& k = tracks[i];
@@ -77,7 +80,13 @@ std::vector<Ball> MatchedMotion::balls_at(double t) const {
         out[i].weight = (t == 0 ? source_balls[static_cast<size_t>(k.source)] : target_balls[static_cast<size_t>(k.target)]).weight;
         continue;
       }
-      r = (1 - t) * radius_of(source_balls[static_cast<size_t>(k.source)]) + t * radius_of(target_balls[static_cast<size_t>(k.target)]);
+      const Ball& from = source_balls[static_cast<size_t>(k.source)];
+      const Ball& to = target_balls[static_cast<size_t>(k.target)];
+      if (from.weight == to.weight) {  // its radius kept exactly (sqrt and square would round it)
+        out[i].weight = from.weight;
+        continue;
+      }
+      r = (1 - t) * radius_of(from) + t * radius_of(to);
     } else if ((t == 0 && k.source >= 0) || (t == 1 && k.target >= 0)) {  // present at this end: as given
       out[i] = t == 0 ? source_balls[static_cast<size_t>(k.source)] : target_balls[static_cast<size_t>(k.target)];
       continue;

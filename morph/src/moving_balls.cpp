@@ -42,12 +42,16 @@ double ball_move(const Ball& a, const Ball& b) {
 
 // The balls a share `a` of the way from `from` to `to`: centres on the
 // straight line; radii linear where both weights are >= 0 (an atom growing
-// from nothing), weights linear otherwise.
+// from nothing), weights linear otherwise. A centre that does not move and
+// a weight that does not change stay as they are, bit for bit: the engine
+// then finds the skin around such balls unchanged.
 std::vector<Ball> balls_between(const std::vector<Ball>& from, const std::vector<Ball>& to, double a) {
   std::vector<Ball> out(from.size());
   for (size_t i = 0; i < out.size(); ++i) {
-    out[i].center = (1 - a) * from[i].center + a * to[i].center;
-    if (from[i].weight >= 0 && to[i].weight >= 0) {
+    out[i].center = from[i].center + a * (to[i].center - from[i].center);
+    if (from[i].weight == to[i].weight) {
+      out[i].weight = from[i].weight;
+    } else if (from[i].weight >= 0 && to[i].weight >= 0) {
       const double r = (1 - a) * radius_of(from[i]) + a * radius_of(to[i]);
       out[i].weight = r * r;
     } else {
