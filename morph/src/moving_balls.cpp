@@ -171,16 +171,35 @@ struct Continuity {
   double bound = 0;
 };
 
-// Per vertex, its longest mesh edge (Angstrom).
+// Per vertex id below `next_id` (ids are handed out in order), its index in
+// `ids`, or -1: a look-up without a hash map of every vertex.
+std::vector<int> vertex_of_id(const std::vector<long>& ids, long next_id) {
+  std::vector<int> index(static_cast<size_t>(next_id), -1);
+  for (size_t v = 0; v < ids.size(); ++v) index[static_cast<size_t>(ids[v])] = static_cast<int>(v);
+  return index;
+}
+
+int vertex_with_id(const std::vector<int>& index, long id) {
+  return id >= 0 && id < static_cast<long>(index.size()) ? index[static_cast<size_t>(id)] : -1;
+}
+
+// Per vertex, its longest mesh edge (Angstrom): the lengths in parallel,
+// each triangle's three, then the largest at each end.
 std::vector<double> longest_edges(const SurfaceMesh& mesh) {
+  std::vector<double> length(3 * mesh.triangles.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.triangles.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t f = r.begin(); f != r.end(); ++f)
+      for (size_t k = 0; k < 3; ++k)
+        length[3 * f + k] = (mesh.vertices[static_cast<size_t>(mesh.triangles[f][k])] -
+                             mesh.vertices[static_cast<size_t>(mesh.triangles[f][(k + 1) % 3])])
+                                .norm();
+  });
   std::vector<double> longest(mesh.vertices.size(), 0.0);
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const size_t a = static_cast<size_t>(t[static_cast<size_t>(k)]);
-      const size_t b = static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)]);
-      const double length = (mesh.vertices[a] - mesh.vertices[b]).norm();
-      longest[a] = std::max(longest[a], length);
-      longest[b] = std::max(longest[b], length);
+  for (size_t f = 0; f < mesh.triangles.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      const size_t a = static_cast<size_t>(mesh.triangles[f][k]), b = static_cast<size_t>(mesh.triangles[f][(k + 1) % 3]);
+      longest[a] = std::max(longest[a], length[3 * f + k]);
+      longest[b] = std::max(longest[b], length[3 * f + k]);
     }
   return longest;
 }
@@ -189,15 +208,17 @@ std::vector<Continuity> continuity_bounds(const SkinComplex& from, const SkinCom
                                          double continuity) {
   const std::vector<double> longest = longest_edges(mesh);
   std::vector<Continuity> out(mesh.vertices.size());
-  for (size_t v = 0; v < out.size(); ++v) {
-    const MixedCell& cell = from.cell(mesh.cells[v]);
-    double balls_moved = 0;
-    for (int i = 0; i <= cell.dim; ++i) {
-      const size_t b = static_cast<size_t>(cell.balls[static_cast<size_t>(i)]);
-      balls_moved = std::max(balls_moved, ball_move(from.balls()[b], to.balls()[b]));
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const MixedCell& cell = from.cell(mesh.cells[v]);
+      double balls_moved = 0;
+      for (int i = 0; i <= cell.dim; ++i) {
+        const size_t b = static_cast<size_t>(cell.balls[static_cast<size_t>(i)]);
+        balls_moved = std::max(balls_moved, ball_move(from.balls()[b], to.balls()[b]));
+      }
+      out[v] = {mesh.vertices[v], balls_moved + continuity * longest[v]};
     }
-    out[v] = {mesh.vertices[v], balls_moved + continuity * longest[v]};
-  }
+  });
   return out;
 }
 
@@ -394,14 +415,8 @@ void check_balls(const std::vector<Ball>& balls, const char* what) {
 
 SkinTopology mesh_topology(const SurfaceMesh& mesh) {
   const size_t n = mesh.vertices.size();
-  std::vector<size_t> parent(n);
-  std::iota(parent.begin(), parent.end(), size_t{0});
-  const auto find = [&](size_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  // Each edge once: per lower end, its higher ends sorted and made unique
-  // (buckets of a few, not one sort of every half-edge).
+  // Each edge once: per lower end, its higher ends, made unique (buckets
+  // of a few, each sorted by insertion).
   std::vector<int> first(n + 1, 0), higher(mesh.triangles.size() * 3);
   std::vector<char> used(n, 0);
   for (const auto& t : mesh.triangles)
@@ -409,7 +424,6 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
       const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
       used[static_cast<size_t>(a)] = 1;
       ++first[static_cast<size_t>(std::min(a, b)) + 1];
-      parent[find(static_cast<size_t>(a))] = find(static_cast<size_t>(b));
     }
   std::partial_sum(first.begin(), first.end(), first.begin());
   std::vector<int> fill(first.begin(), first.end() - 1);
@@ -418,21 +432,35 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
       const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
       higher[static_cast<size_t>(fill[static_cast<size_t>(std::min(a, b))]++)] = std::max(a, b);
     }
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](int x) {
+    while (parent[static_cast<size_t>(x)] != x)
+      x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
+    return x;
+  };
   long edge_count = 0;
   for (size_t v = 0; v < n; ++v) {
-    const auto begin = higher.begin() + first[v], end = higher.begin() + first[v + 1];
-    std::sort(begin, end);
-    edge_count += std::unique(begin, end) - begin;
+    int* const begin = higher.data() + first[v];
+    int* const end = higher.data() + first[v + 1];
+    for (int* i = begin + 1; i < end; ++i)  // insertion sort: a vertex has a handful of higher neighbours
+      for (int* j = i; j > begin && *(j - 1) > *j; --j) std::swap(*(j - 1), *j);
+    for (int* i = begin; i < end; ++i) {
+      if (i > begin && *i == *(i - 1)) continue;
+      ++edge_count;
+      const int a = find(static_cast<int>(v)), b = find(*i);
+      if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+    }
   }
   std::vector<double> volume(n, 0.0);  // signed, per component root
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
-    volume[find(static_cast<size_t>(t[0]))] +=
+    volume[static_cast<size_t>(find(t[0]))] +=
         a.dot(mesh.vertices[static_cast<size_t>(t[1])].cross(mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
   }
   SkinTopology out;
   for (size_t v = 0; v < n; ++v)
-    if (used[v] && find(v) == v) {
+    if (used[v] && find(static_cast<int>(v)) == static_cast<int>(v)) {
       ++out.components;
       out.voids += volume[v] < 0;
     }
@@ -528,9 +556,8 @@ const MorphFrame& MovingBalls::Impl::advance_to(std::vector<Ball> balls, double 
   if (balls.size() != from.size()) contract_error("MovingBalls::advance_to: the number of balls differs");
   check_balls(balls, "MovingBalls::advance_to");
   const auto start = Clock::now();
-  std::unordered_map<long, Eigen::Vector3d> before;  // the frame before, by vertex id
-  before.reserve(frame_.ids.size());
-  for (size_t v = 0; v < frame_.ids.size(); ++v) before.emplace(frame_.ids[v], frame_.mesh.vertices[v]);
+  const std::vector<Eigen::Vector3d> before = frame_.mesh.vertices;  // the frame before
+  const std::vector<int> was = vertex_of_id(frame_.ids, next_id_);
   double farthest = 0;
   for (size_t i = 0; i < from.size(); ++i) farthest = std::max(farthest, ball_move(from[i], balls[i]));
   const long steps = std::max(1L, static_cast<long>(std::ceil(farthest / options_.max_step)));
@@ -542,10 +569,10 @@ const MorphFrame& MovingBalls::Impl::advance_to(std::vector<Ball> balls, double 
   s.steps = steps;
   long kept = 0;
   for (size_t v = 0; v < frame_.ids.size(); ++v) {
-    const auto found = before.find(frame_.ids[v]);
-    if (found == before.end()) continue;
+    const int found = vertex_with_id(was, frame_.ids[v]);
+    if (found < 0) continue;
     ++kept;
-    s.max_kept_move = std::max(s.max_kept_move, (frame_.mesh.vertices[v] - found->second).norm());
+    s.max_kept_move = std::max(s.max_kept_move, (frame_.mesh.vertices[v] - before[static_cast<size_t>(found)]).norm());
   }
   s.vertices = static_cast<long>(frame_.mesh.vertices.size());
   s.triangles = static_cast<long>(frame_.mesh.triangles.size());
@@ -605,9 +632,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
     s.relocated += fates[v] == VertexFate::relocated;
     s.lost += lost[v];
   }
-  std::unordered_map<long, size_t> index_before;  // a vertex id -> its index in `reach`
-  index_before.reserve(n);
-  for (size_t v = 0; v < n; ++v) index_before.emplace(frame_.ids[v], v);
+  const std::vector<int> index_before = vertex_of_id(frame_.ids, next_id_);  // a vertex id -> its index in `reach`
   s.seconds_transport += seconds_since(stage);
   stage = Clock::now();
   counting.wait();
@@ -617,9 +642,9 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
   // moved farther in the step than its bound, by transport, relaxation,
   // an edit or a remesh, is another point of the skin and takes a new id.
   for (size_t v = 0; v < frame_.ids.size(); ++v) {
-    const auto found = index_before.find(frame_.ids[v]);
-    if (found == index_before.end()) continue;
-    const Continuity& c = reach[found->second];
+    const int found = vertex_with_id(index_before, frame_.ids[v]);
+    if (found < 0) continue;
+    const Continuity& c = reach[static_cast<size_t>(found)];
     if ((frame_.mesh.vertices[v] - c.from).norm() > c.bound) {
       frame_.ids[v] = next_id_++;
       ++s.reidentified;
