@@ -253,6 +253,7 @@ struct MadeFrame {
   size_t index = 0;
   MorphFrame frame;
   std::vector<Ball> balls;
+  SkinTopology topology;  // of `balls`, as the engine counted it (skin_topology)
   std::vector<int> owner, patch;  // per vertex: its ball, its patch type
   double shrink = 0.5;
 };
@@ -262,6 +263,7 @@ MadeFrame snapshot(const MovingBalls& moving, size_t k) {
   m.index = k;
   m.frame = moving.frame();
   m.balls = moving.balls();
+  m.topology = moving.topology();
   m.owner = moving.vertex_balls();
   for (int c : m.frame.mesh.cells) m.patch.push_back(moving.complex().cell(c).dim);
   m.shrink = moving.complex().shrink();
@@ -269,7 +271,8 @@ MadeFrame snapshot(const MovingBalls& moving, size_t k) {
 }
 
 FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self_intersections) {
-  return check_frame(made.frame.mesh, SkinReference{made.balls, made.shrink, {}}, min_angle, self_intersections);
+  return check_frame(made.frame.mesh, SkinReference{made.balls, made.shrink, {}, made.topology}, min_angle,
+                     self_intersections);
 }
 
 json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {

@@ -52,7 +52,7 @@ GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const SkinReference& s
   tbb::parallel_invoke([&] { r.quality = grade_mesh(mesh, grade); },
                        [&] { r.surface_error = distances(mesh.vertices, skin); },
                        [&] {
-                         if (options.topology) r.skin = skin_topology(skin.balls);
+                         if (options.topology) r.skin = skin.topology ? *skin.topology : skin_topology(skin.balls);
                        });
   const MeshQuality& q = r.quality;
   // The bound is met to rounding: angles are computed from the written
@@ -69,7 +69,7 @@ GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const SkinReference& s
 
 GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const std::vector<Ball>& balls, double shrink,
                                  const GuaranteeOptions& options) {
-  return check_guarantees(mesh, SkinReference{balls, shrink, {}}, options);
+  return check_guarantees(mesh, SkinReference{balls, shrink, {}, {}}, options);
 }
 
 }  // namespace skinmesh

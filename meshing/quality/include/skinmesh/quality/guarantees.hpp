@@ -31,6 +31,10 @@ struct SkinReference {
   double shrink = 0.5;
   // The oracle; empty: the static oracle of `balls` (SkinOracle).
   PointOracle oracle;
+  // The skin's topology when the caller has counted it already, by
+  // skin_topology on these same balls (the moving-balls engine does at every
+  // step); empty: counted here.
+  std::optional<SkinTopology> topology;
 };
 
 struct GuaranteeOptions {
