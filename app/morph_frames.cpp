@@ -254,6 +254,7 @@ struct MadeFrame {
   MorphFrame frame;
   std::vector<Ball> balls;
   SkinTopology topology;  // of `balls`, as the engine counted it (skin_topology)
+  std::vector<std::array<int, 4>> starts;  // per vertex: its cell's balls, where the check's oracle starts
   std::vector<int> owner, patch;  // per vertex: its ball, its patch type
   double shrink = 0.5;
 };
@@ -265,14 +266,17 @@ MadeFrame snapshot(const MovingBalls& moving, size_t k) {
   m.balls = moving.balls();
   m.topology = moving.topology();
   m.owner = moving.vertex_balls();
-  for (int c : m.frame.mesh.cells) m.patch.push_back(moving.complex().cell(c).dim);
+  for (int c : m.frame.mesh.cells) {
+    m.patch.push_back(moving.complex().cell(c).dim);
+    m.starts.push_back(moving.complex().cell(c).balls);
+  }
   m.shrink = moving.complex().shrink();
   return m;
 }
 
 FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self_intersections) {
-  return check_frame(made.frame.mesh, SkinReference{made.balls, made.shrink, {}, made.topology}, min_angle,
-                     self_intersections);
+  return check_frame(made.frame.mesh, SkinReference{made.balls, made.shrink, {}, made.starts, made.topology},
+                     min_angle, self_intersections);
 }
 
 json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {

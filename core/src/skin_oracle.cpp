@@ -329,6 +329,23 @@ std::vector<int> least_power(const BallGrid& grid, const std::vector<Ball>& ball
 }  // namespace
 
 OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
+  if (!x.allFinite()) return solve_from(x, {});
+  return solve_from(x, least_power(*grid_, balls_, x, 12));
+}
+
+OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x, const std::array<int, 4>& start) const {
+  std::vector<int> candidates;
+  for (int ball : start) {
+    if (ball >= static_cast<int>(balls_.size())) contract_error("SkinOracle::evaluate: a start ball past the last ball");
+    if (ball >= 0) candidates.push_back(ball);
+  }
+  if (candidates.empty()) return evaluate(x);
+  return solve_from(x, std::move(candidates));
+}
+
+// The solve from `candidates` (not empty for a finite x), which grow by
+// every ball the KKT check finds violating until none does.
+OracleResult SkinOracle::solve_from(const Eigen::Vector3d& x, std::vector<int> candidates) const {
   if (!x.allFinite()) {  // no answer to certify (the maxima below would pass NaN over)
     OracleResult none;
     none.value = NAN;
@@ -336,7 +353,6 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x) const {
     return none;
   }
   const Problem p{balls_, shrink_, x};
-  std::vector<int> candidates = least_power(*grid_, balls_, x, 12);
   OracleResult out;
   for (int round = 0; round < 50; ++round) {
     const Solution sol = solve_on(p, candidates);

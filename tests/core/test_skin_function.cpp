@@ -1,6 +1,7 @@
 // The mixed-cell quadrics against the independent oracle of docs/math.md section 2.
 #include "test_support.hpp"
 
+#include "skinmesh/core/error.hpp"
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
@@ -183,6 +184,41 @@ TEST_CASE("the oracle is certified on the skin and far from the origin", "[skin]
   CHECK(uncertified == 0);
   CHECK(worst <= 1e-9);
   CHECK(worst_moved <= 1e-6);  // 1000 A coordinates keep ~12 digits of the local geometry
+}
+
+TEST_CASE("the oracle started from given balls gives the answer it gives from the balls of least power",
+          "[skin][oracle]") {
+  // The start only changes where the solve begins: from the balls of each
+  // point's mixed cell, from balls far from it, from one ball, the answer is
+  // the same minimiser, certified against every ball.
+  const double s = 0.5;
+  const auto balls = balls_from_molecule(read_molecule(test::data_file("1ubi.pdb")), s);
+  const SkinComplex sc = build_skin_complex(balls, {s});
+  const SkinOracle oracle(balls, s);
+  const auto near = test::sample_near_balls(balls, s, 2000, 1.0, 7);
+  const int far_ball = 0;
+  long compared = 0;
+  for (const Eigen::Vector3d& x : near) {
+    const Projection p = sc.project(x);
+    std::vector<Eigen::Vector3d> points{x};  // near the skin, and on it
+    if (p.converged) points.push_back(p.point);
+    for (const Eigen::Vector3d& point : points) {
+      const int cell = sc.locate(point);
+      const OracleResult plain = oracle.evaluate(point);
+      REQUIRE(plain.certified);
+      for (const std::array<int, 4>& start : {sc.cell(cell).balls, std::array<int, 4>{far_ball, -1, -1, -1},
+                                               std::array<int, 4>{-1, -1, -1, -1}}) {
+        const OracleResult o = oracle.evaluate(point, start);
+        INFO("start " << start[0] << " " << start[1] << " " << start[2] << " " << start[3]);
+        CHECK(o.certified);
+        CHECK(std::abs(o.value - plain.value) <= 1e-12 * (1 + std::abs(plain.value)));
+        CHECK((o.gradient - plain.gradient).norm() <= 1e-10 * (1 + plain.gradient.norm()));
+        ++compared;
+      }
+    }
+  }
+  CHECK(compared >= 3 * 2 * 1900);
+  CHECK_THROWS_AS(oracle.evaluate(near[0], {static_cast<int>(balls.size()), -1, -1, -1}), ContractError);
 }
 
 TEST_CASE("cospherical and interpolated ball sets: skin function and crossings equal the oracle",

@@ -68,7 +68,7 @@ TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where bro
     CHECK(skipped.all_hold());
   }
   SECTION("the skin given by another oracle: its distances, and the complex where it does not certify") {
-    SkinReference skin{balls, 0.5, [](const Eigen::Vector3d&) { return SkinDistance{0.02, true}; }, {}};
+    SkinReference skin{balls, 0.5, [](const Eigen::Vector3d&) { return SkinDistance{0.02, true}; }, {}, {}};
     const GuaranteeReport off = check_guarantees(r.mesh, skin);
     CHECK(off.surface_error.max == 0.02);
     CHECK_FALSE(off.on_skin);
@@ -79,7 +79,7 @@ TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where bro
     CHECK(measured.all_hold());
   }
   SECTION("the skin's topology as the caller counted it, not counted again") {
-    SkinReference skin{balls, 0.5, {}, good.skin};
+    SkinReference skin{balls, 0.5, {}, {}, good.skin};
     CHECK(check_guarantees(r.mesh, skin).topology == std::optional<bool>(true));
     SkinTopology wrong = *good.skin;
     wrong.euler += 2;

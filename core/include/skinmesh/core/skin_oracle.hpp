@@ -12,6 +12,8 @@
 
 #include <Eigen/Core>
 
+#include <array>
+
 #include <memory>
 #include <utility>
 #include <vector>
@@ -35,6 +37,14 @@ class SkinOracle {
  public:
   SkinOracle(std::vector<Ball> balls, double shrink);
   OracleResult evaluate(const Eigen::Vector3d& x) const;
+  // The same, with the solve started from `start`'s balls (indices into
+  // balls(), -1 for none; e.g. the balls of the mixed cell a mesh vertex
+  // lies in) instead of the balls of least power at x. The answer is
+  // certified against every ball either way, so it does not depend on the
+  // start; a start that holds the minimiser's support spares the search for
+  // candidates and most steps of the solve. No valid ball: as evaluate(x).
+  // Throws ContractError for an index past the last ball.
+  OracleResult evaluate(const Eigen::Vector3d& x, const std::array<int, 4>& start) const;
   double shrink() const { return shrink_; }
   const std::vector<Ball>& balls() const { return balls_; }
 
@@ -44,6 +54,7 @@ class SkinOracle {
   // Balls far from x are certified by a bound instead of one by one
   // (evaluate); the grid finds the near ones.
   std::shared_ptr<const BallGrid> grid_;
+  OracleResult solve_from(const Eigen::Vector3d& x, std::vector<int> candidates) const;
   friend class MorphOracle;  // certifies each side's balls with its grid the same way
 };
 

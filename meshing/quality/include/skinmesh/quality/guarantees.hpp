@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -31,6 +32,11 @@ struct SkinReference {
   double shrink = 0.5;
   // The oracle; empty: the static oracle of `balls` (SkinOracle).
   PointOracle oracle;
+  // Per vertex, or empty: the balls where the static oracle's solve starts
+  // at it (SkinOracle::evaluate with a start; a mesher's vertex: the balls
+  // of its mixed cell). The oracle certifies its answer against every ball
+  // whatever the start: a good one only makes it faster.
+  std::vector<std::array<int, 4>> starts;
   // The skin's topology when the caller has counted it already, by
   // skin_topology on these same balls (the moving-balls engine does at every
   // step); empty: counted here.
