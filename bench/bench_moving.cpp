@@ -4,7 +4,10 @@
 //   (b) each frame rebuilt from scratch by skinmesh's mesher from the moved
 //       atoms (complex and mesh, at the frame criteria: 20 degrees);
 //   (c) the moving-balls engine: the first frame meshed, every later frame
-//       carried from the one before.
+//       carried from the one before;
+//   (c_cmd) `skinmesh trajectory` over the same frames written as the models
+//       of a PDB file (a frame per model): the engine with the command's
+//       check of every frame and its output, as a user runs it.
 // Motions: 2k39 model 1 -> 3 (fitted by Kabsch), a hinge motion of 3mht's
 // protein (residues 187-304 of chain A turned by 20 degrees), and 3mht's
 // DNA (chains C and D of its 3,141 atoms) moved 6 A off the protein and
@@ -17,7 +20,7 @@
 // against the skin's) and every vertex measured by the static oracle of the
 // frame's balls.
 //
-//   bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT]
+//   bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command]
 #include "forked.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/stopwatch.hpp"
@@ -28,14 +31,21 @@
 
 #include <Eigen/Geometry>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 using namespace skinmesh;
 
@@ -45,11 +55,13 @@ constexpr double kShrink = 0.5;
 
 std::string data(const std::string& name) { return std::string(SKINMESH_DATA_DIR) + "/" + name; }
 
-// A motion: the balls at s in [0,1].
+// A motion: the balls at s in [0,1], and the atoms they are (in order),
+// from which the command's column writes the motion as a PDB file.
 struct Motion {
   std::string name;
   size_t atoms = 0;
   std::function<std::vector<Ball>(double)> at;
+  std::vector<Atom> atom_records;
 };
 
 // 3mht's two DNA strands (chains C and D) moved 6 A away from the protein
@@ -71,13 +83,15 @@ Motion dna_3mht() {
   dna /= nd;
   const Eigen::Vector3d away = (dna - protein).normalized();
   const Eigen::Vector3d axis = away.cross(Eigen::Vector3d(0, 0, 1)).normalized();
-  return {"3mht DNA 6 A out, 20 deg", start.size(), [=](double s) {
+  return {"3mht DNA 6 A out, 20 deg", start.size(),
+          [=](double s) {
             const Eigen::Matrix3d turn = Eigen::AngleAxisd(s * 20 * M_PI / 180, axis).toRotationMatrix();
             std::vector<Ball> balls = start;
             for (size_t i = 0; i < balls.size(); ++i)
               if (moving[i]) balls[i].center = dna + s * 6 * away + turn * (start[i].center - dna);
             return balls;
-          }};
+          },
+          m.atoms};
 }
 
 // A hinge motion of 3mht's protein alone (chain A, 2,632 atoms as read):
@@ -87,24 +101,28 @@ Motion hinge_3mht() {
   const Molecule m = read_molecule(data("3mht.pdb"));
   const std::vector<Ball> all = balls_from_molecule(m, kShrink);
   std::vector<Ball> start;
+  std::vector<Atom> chain_a;
   std::vector<char> moving;
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero(), end = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < m.atoms.size(); ++i) {
     const Atom& a = m.atoms[i];
     if (a.chain != "A") continue;
     start.push_back(all[i]);
+    chain_a.push_back(a);
     moving.push_back(a.residue_number >= 187 && a.residue_number <= 304);
     if (a.name == "CA" && a.residue_number == 186) pivot = a.position;
     if (a.name == "CA" && a.residue_number == 305) end = a.position;
   }
   const Eigen::Vector3d axis = (end - pivot).normalized();
-  return {"3mht protein hinge, 20 deg", start.size(), [=](double s) {
+  return {"3mht protein hinge, 20 deg", start.size(),
+          [=](double s) {
             const Eigen::Matrix3d turn = Eigen::AngleAxisd(s * 20 * M_PI / 180, axis).toRotationMatrix();
             std::vector<Ball> balls = start;
             for (size_t i = 0; i < balls.size(); ++i)
               if (moving[i]) balls[i].center = pivot + turn * (start[i].center - pivot);
             return balls;
-          }};
+          },
+          chain_a};
 }
 
 Motion models_2k39() {
@@ -115,12 +133,14 @@ Motion models_2k39() {
   const RigidMotion fit = align(first, third, AlignmentMethod::kabsch).motion;  // before third is moved from
   third = moved(std::move(third), fit);
   const std::vector<Ball> a = balls_from_molecule(first, kShrink), b = balls_from_molecule(third, kShrink);
-  return {"2k39 model 1 -> 3", a.size(), [=](double s) {
+  return {"2k39 model 1 -> 3", a.size(),
+          [=](double s) {
             if (s == 1) return b;
             std::vector<Ball> balls = a;
             for (size_t i = 0; i < balls.size(); ++i) balls[i].center = (1 - s) * a[i].center + s * b[i].center;
             return balls;
-          }};
+          },
+          first.atoms};
 }
 
 // 1ubi's atoms in thermal motion as an MD trajectory saved every few
@@ -132,7 +152,8 @@ Motion models_2k39() {
 // 64-bit Mersenne twister (whose sequence the standard fixes), so every run
 // and every machine sees the same motion.
 Motion thermal_1ubi() {
-  const std::vector<Ball> rest = balls_from_molecule(read_molecule(data("1ubi.pdb")), kShrink);
+  const Molecule ubi = read_molecule(data("1ubi.pdb"));
+  const std::vector<Ball> rest = balls_from_molecule(ubi, kShrink);
   constexpr int kSnapshots = 11;
   constexpr double kRms = 0.5, kCorrelation = 0.8;
   std::mt19937_64 random(20261127);
@@ -148,7 +169,8 @@ Motion thermal_1ubi() {
   for (int m = 1; m < kSnapshots; ++m)
     for (size_t i = 0; i < rest.size(); ++i)
       for (int k = 0; k < 3; ++k) offsets[m][i][k] = kCorrelation * offsets[m - 1][i][k] + renew * sigma * gaussian();
-  return {"1ubi thermal motion, 11 snapshots", rest.size(), [=](double s) {
+  return {"1ubi thermal motion, 11 snapshots", rest.size(),
+          [=](double s) {
             const double at = s * (kSnapshots - 1);
             const int m = std::min(static_cast<int>(at), kSnapshots - 2);
             const double w = at - m;
@@ -156,7 +178,8 @@ Motion thermal_1ubi() {
             for (size_t i = 0; i < balls.size(); ++i)
               balls[i].center += (1 - w) * offsets[m][i] + w * offsets[m + 1][i];
             return balls;
-          }};
+          },
+          ubi.atoms};
 }
 
 struct Column {
@@ -233,6 +256,64 @@ Column run_rebuilds(const Motion& motion, int frames, int sample) {
   return c;
 }
 
+// The motion's frames as the models of one PDB file (coordinates to the
+// 1e-3 A PDB keeps: an atom that does not move is written the same way in
+// every model).
+void write_models(const std::string& path, const Motion& motion, int frames) {
+  std::FILE* out = std::fopen(path.c_str(), "w");
+  if (!out) throw std::runtime_error("cannot write " + path);
+  for (int k = 0; k < frames; ++k) {
+    const std::vector<Ball> balls = motion.at(s_of(k, frames));
+    std::fprintf(out, "MODEL     %4d\n", k + 1);
+    for (size_t i = 0; i < balls.size(); ++i) {
+      const Atom& a = motion.atom_records[i];
+      const std::string name = a.name.size() < 4 && a.element.size() < 2 ? " " + a.name : a.name;
+      std::fprintf(out, "ATOM  %5zu %-4.4s %3.3s %1.1s%4d%c   %8.3f%8.3f%8.3f%6.2f%6.2f          %2.2s\n", (i + 1) % 100000,
+                   name.c_str(), a.residue.c_str(), a.chain.c_str(), a.residue_number, a.insertion_code,
+                   balls[i].center.x(), balls[i].center.y(), balls[i].center.z(), 1.0, 0.0, a.element.c_str());
+    }
+    std::fprintf(out, "ENDMDL\n");
+  }
+  std::fprintf(out, "END\n");
+  if (std::fclose(out) != 0) throw std::runtime_error("cannot write " + path);
+}
+
+// (c_cmd): `skinmesh trajectory` over those models, a frame per model, as a
+// user runs it on an MD trajectory saved as models (binary PLY frames; the
+// default adds VTP): wall time less the first frame's meshing, per later
+// frame. Every frame is checked by the command before it is written.
+Column run_command(const Motion& motion, int frames) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("bench_moving_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string models = (dir / "models.pdb").string(), out = (dir / "frames").string();
+  write_models(models, motion, frames);
+  const std::string command = std::string("'") + SKINMESH_BINARY + "' --quiet trajectory '" + models + "' -o '" + out +
+                              "' --frames-per-step 1 --align none --format ply";
+  const auto start = Clock::now();
+  const int status = std::system(command.c_str());
+  Column c;
+  c.seconds = seconds_since(start);
+  std::ifstream jsonl(std::filesystem::path(out) / "frames.jsonl");
+  for (std::string line; std::getline(jsonl, line);) {
+    const nlohmann::json f = nlohmann::json::parse(line);
+    if (c.frames == 0) c.seconds_first = f["seconds"].get<double>();
+    c.frames += 1;
+    c.triangles += f["triangles"].get<double>();
+    c.min_angle = std::min(c.min_angle, f["min_angle"].get<double>());
+    c.max_error = std::max(c.max_error, f["max_onsurf_error"].get<double>());
+    c.remeshed += f["remeshed"].get<bool>();
+    c.full_rebuilds += f["full_rebuild"].get<bool>();
+    if (c.frames > 1) {
+      c.min_ids_kept = std::min(c.min_ids_kept, f["ids_kept"].get<double>());
+      c.mean_ids_kept += f["ids_kept"].get<double>() / (frames - 1);
+      c.max_kept_move = std::max(c.max_kept_move, f["max_kept_move"].get<double>());
+    }
+  }
+  std::filesystem::remove_all(dir);
+  if (status != 0 || c.frames != frames) throw std::runtime_error("the command failed: " + command);
+  return c;
+}
+
 struct Row {
   std::string motion, column;
   size_t atoms = 0;
@@ -286,19 +367,37 @@ void print_table(const std::vector<Row>& rows) {
   }
 }
 
+// Per motion: b/c, b/c_cmd and c_cmd/c (the command's frame against the engine's).
+void print_ratios(const std::vector<Row>& rows) {
+  std::printf("\n| motion | b/c | b/c_cmd | c_cmd/c |\n|---|---|---|---|\n");
+  for (const Row& b : rows) {
+    if (b.column[0] != 'b' || b.run.status != "ok") continue;
+    const Row *c = nullptr, *cmd = nullptr;
+    for (const Row& r : rows)
+      if (r.motion == b.motion && r.run.status == "ok") {
+        if (r.column.rfind("c moving", 0) == 0) c = &r;
+        if (r.column.rfind("c_cmd", 0) == 0) cmd = &r;
+      }
+    const auto ratio = [](const Row* x, const Row* y) { return x && y ? per_frame(*x) / per_frame(*y) : NAN; };
+    std::printf("| %s | %.1f | %.1f | %.2f |\n", b.motion.c_str(), ratio(&b, c), ratio(&b, cmd), ratio(cmd, c));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int frames = 101, sample = 5, timeout = 3600;
   std::string only;  // run the motions whose name holds this text
+  bool skip_command = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--only" && i + 1 < argc) only = argv[++i];
+    else if (a == "--skip-command") skip_command = true;
     else if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
     else if (a == "--sample" && i + 1 < argc) sample = std::atoi(argv[++i]);
     else if (a == "--timeout" && i + 1 < argc) timeout = std::atoi(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT]\n");
+      std::fprintf(stderr, "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command]\n");
       return 2;
     }
   }
@@ -317,7 +416,13 @@ int main(int argc, char** argv) {
           bench::run_forked<Column>(timeout, [&] { return run_engine(motion, frames); })};
     print_json(c);
     rows.push_back(c);
+    if (skip_command) continue;
+    Row cmd{motion.name, "c_cmd skinmesh trajectory", motion.atoms,
+            bench::run_forked<Column>(timeout, [&] { return run_command(motion, frames); })};
+    print_json(cmd);
+    rows.push_back(cmd);
   }
   print_table(rows);
+  print_ratios(rows);
   return 0;
 }
