@@ -222,40 +222,74 @@ std::vector<Continuity> continuity_bounds(const SkinComplex& from, const SkinCom
   return out;
 }
 
+// How the vertices of one cell of the step before move (docs/math.md
+// section 6), worked out once per cell, not once per vertex: the cell it
+// persists as (-1: gone); whether its balls are all quiet (its vertices
+// stay); else, where it persists with a size of the same sign and is not
+// flat, its exact map x -> to_center + scale turn (x - from_center).
+struct CellMap {
+  int persisting = -1;
+  bool quiet = false;
+  bool mapped = false;
+  Eigen::Vector3d from_center = Eigen::Vector3d::Zero(), to_center = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
+  double scale = 1;
+};
+
+// The maps of the cells of `from` that `cells` (per vertex) name; the others stay default.
+std::vector<CellMap> cell_maps(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
+                               const std::vector<char>& quiet, const std::vector<int>& cells) {
+  std::vector<char> used(from.cells().size(), 0);
+  for (int c : cells) used[static_cast<size_t>(c)] = 1;
+  std::vector<CellMap> maps(used.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, used.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t c = r.begin(); c != r.end(); ++c) {
+      if (!used[c]) continue;
+      CellMap& m = maps[c];
+      const MixedCell& c0 = from.cell(static_cast<int>(c));
+      m.persisting = to.find_cell(c0.balls);
+      if (m.persisting < 0) continue;
+      m.quiet = cell_of_flagged_balls(c0, quiet);
+      const MixedCell& c1 = to.cell(m.persisting);
+      const double ratio = c1.R2 / c0.R2;
+      m.mapped = !c0.degenerate && !c1.degenerate && c0.dim == c1.dim && c0.R2 != 0 && ratio > 0;
+      if (!m.mapped) continue;
+      m.from_center = c0.center;
+      m.to_center = c1.center;
+      m.turn = cell_rotation(c0, from.balls(), to.balls(), rotations);
+      m.scale = std::sqrt(ratio);
+    }
+  });
+  return maps;
+}
+
 // One vertex from the skin of `from` onto the skin of `to`: by its cell's
 // map where the cell persists with a size of the same sign, else projected
 // from where its owning ball took it.
-VertexFate move_vertex(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
-                       const std::vector<char>& quiet, Eigen::Vector3d& p, int& cell) {
-  const MixedCell& c0 = from.cell(cell);
-  const int persisting = to.find_cell(c0.balls);
-  if (persisting >= 0 && cell_of_flagged_balls(c0, quiet)) {
-    cell = persisting;
+VertexFate move_vertex(const SkinComplex& from, const SkinComplex& to, const CellMap& map, Eigen::Vector3d& p,
+                       int& cell) {
+  if (map.persisting >= 0 && map.quiet) {
+    cell = map.persisting;
     return VertexFate::kept;
   }
-  if (persisting >= 0) {
-    const MixedCell& c1 = to.cell(persisting);
-    const double ratio = c1.R2 / c0.R2;
-    if (!c0.degenerate && !c1.degenerate && c0.dim == c1.dim && c0.R2 != 0 && ratio > 0) {
-      const Eigen::Vector3d q =
-          c1.center + std::sqrt(ratio) * (cell_rotation(c0, from.balls(), to.balls(), rotations) * (p - c0.center));
-      constexpr double kOnBoundary = 1e-9;  // Angstrom-scaled membership slack (rounding on a cell face)
-      if (to.membership_violation(persisting, q) <= kOnBoundary) {
-        p = q;
-        cell = persisting;
-        return VertexFate::moved;
-      }
-      const Projection projected = to.project(q, persisting, 1e-14);
-      if (!projected.converged) return VertexFate::lost;
-      p = projected.point;
-      cell = projected.cell;
-      return VertexFate::relocated;
+  if (map.mapped) {
+    const Eigen::Vector3d q = map.to_center + map.scale * (map.turn * (p - map.from_center));
+    constexpr double kOnBoundary = 1e-9;  // Angstrom-scaled membership slack (rounding on a cell face)
+    if (to.membership_violation(map.persisting, q) <= kOnBoundary) {
+      p = q;
+      cell = map.persisting;
+      return VertexFate::moved;
     }
+    const Projection projected = to.project(q, map.persisting, 1e-14);
+    if (!projected.converged) return VertexFate::lost;
+    p = projected.point;
+    cell = projected.cell;
+    return VertexFate::relocated;
   }
   const int owner = from.owning_ball(p, cell);
   const Eigen::Vector3d start =
       p + (to.balls()[static_cast<size_t>(owner)].center - from.balls()[static_cast<size_t>(owner)].center);
-  const int hint = persisting >= 0 ? persisting : to.vertex_cell(owner);
+  const int hint = map.persisting >= 0 ? map.persisting : to.vertex_cell(owner);
   const Projection projected = to.project(start, hint, 1e-14);
   if (!projected.converged) {
     cell = to.locate(p, hint);  // a valid cell of the new complex for a vertex the remesh drops
@@ -610,9 +644,10 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
   const std::vector<Continuity> reach = continuity_bounds(complex_, next, moved, options_.continuity);
   const size_t n = moved.vertices.size();
   std::vector<VertexFate> fates(n);
+  const std::vector<CellMap> maps = cell_maps(complex_, next, rotations, quiet, moved.cells);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
-      fates[v] = move_vertex(complex_, next, rotations, quiet, moved.vertices[v], moved.cells[v]);
+      fates[v] = move_vertex(complex_, next, maps[static_cast<size_t>(moved.cells[v])], moved.vertices[v], moved.cells[v]);
       if (fates[v] == VertexFate::moved || fates[v] == VertexFate::relocated)
         moved.normals[v] = next.evaluate(moved.vertices[v], moved.cells[v]).gradient.normalized();
     }
