@@ -201,17 +201,22 @@ struct FrameReference {
 };
 
 // The frame against the skin of B(t): distances by the morph oracle, which
-// knows neither the morph's complex nor its live pairs (a point it cannot
-// certify is measured on the complex of B(t)'s balls built from scratch, a
-// regular triangulation, not the morph's overlay); the topology from B(t)'s
-// balls.
-FrameCheck check_blend_frame(const SurfaceMesh& mesh, const FrameReference& reference, double t, double min_angle,
-                             bool self_intersections) {
+// certifies every answer against all m x n pairs (a point it cannot certify
+// is measured on the complex of B(t)'s balls built from scratch, a regular
+// triangulation, not the morph's overlay); its solve at a vertex starts
+// from the live pairs of the vertex's overlay cell (`starts`, indices into
+// reference.pairs; empty: its own start). The topology from B(t)'s balls.
+FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleStart>& starts,
+                             const FrameReference& reference, double t, double min_angle, bool self_intersections) {
   SkinReference skin;
   skin.balls = reference.balls_at(t);
   skin.shrink = reference.shrink;
-  skin.oracle = [&reference, t](const Eigen::Vector3d& x) {
-    const MorphOracleResult e = reference.oracle.evaluate(x, t);
+  skin.starts = starts;
+  skin.oracle = [&reference, t](const Eigen::Vector3d& x, const OracleStart& start) {
+    std::vector<BallPair> pairs;
+    for (int k : start)
+      if (k >= 0 && k < static_cast<int>(reference.pairs.size())) pairs.push_back(reference.pairs[static_cast<size_t>(k)]);
+    const MorphOracleResult e = reference.oracle.evaluate(x, t, pairs);
     return SkinDistance{e.distance(), e.certified};
   };
   return check_frame(mesh, skin, min_angle, self_intersections);
@@ -232,6 +237,7 @@ struct BlendFrame {
   MorphFrame frame;
   std::vector<int> patch;                 // per vertex: the dimension of its cell's Delaunay simplex
   std::vector<std::array<int, 2>> sides;  // per vertex: its source and target atoms (-1: none)
+  std::vector<OracleStart> starts;        // per vertex in (0,1): its overlay cell's live pairs, where the check starts
 };
 
 BlendFrame snapshot_blend(const Morph& morph, size_t k, double t) {
@@ -241,6 +247,9 @@ BlendFrame snapshot_blend(const Morph& morph, size_t k, double t) {
   b.frame = morph.frame();
   for (int cell : b.frame.mesh.cells) b.patch.push_back(morph.complex().cell(cell).dim);
   b.sides = morph.vertex_atoms();
+  // At t = 0 and 1 the frame lies on one side's own complex, whose balls are not pairs.
+  if (t > 0 && t < 1)
+    for (int cell : b.frame.mesh.cells) b.starts.push_back(morph.complex().cell(cell).balls);
   return b;
 }
 
@@ -502,7 +511,9 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
     BlendFrame made = snapshot_blend(morph, k, times[k]);
     if (k > 0 && !finish()) return false;
     pending = std::move(made);
-    checking.run([&] { check = check_blend_frame(pending.frame.mesh, reference, pending.t, min_angle, self_intersections); });
+    checking.run([&] {
+      check = check_blend_frame(pending.frame.mesh, pending.starts, reference, pending.t, min_angle, self_intersections);
+    });
   }
   return finish();
 }

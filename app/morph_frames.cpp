@@ -254,7 +254,7 @@ struct MadeFrame {
   MorphFrame frame;
   std::vector<Ball> balls;
   SkinTopology topology;  // of `balls`, as the engine counted it (skin_topology)
-  std::vector<std::array<int, 4>> starts;  // per vertex: its cell's balls, where the check's oracle starts
+  std::vector<OracleStart> starts;  // per vertex: its cell's balls, where the check's oracle starts
   std::vector<int> owner, patch;  // per vertex: its ball, its patch type
   double shrink = 0.5;
 };

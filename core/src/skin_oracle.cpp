@@ -627,15 +627,33 @@ MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t) cons
   if (!(t >= 0 && t <= 1)) contract_error("MorphOracle: t must lie in [0, 1]");
   if (t == 0) return end_result(source_.evaluate(x), true);
   if (t == 1) return end_result(target_.evaluate(x), false);
+  // Candidates: every pair of a few balls of least power on each side (four:
+  // the pairs grow as the square, and fewer cost more rounds).
+  std::vector<BallPair> pairs;
+  for (int i : least_power(*source_.grid_, source_.balls(), x, 4))
+    for (int j : least_power(*target_.grid_, target_.balls(), x, 4)) pairs.push_back({i, j});
+  return solve_from(x, t, std::move(pairs));
+}
+
+MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t, const std::vector<BallPair>& start) const {
+  if (!(t >= 0 && t <= 1)) contract_error("MorphOracle: t must lie in [0, 1]");
+  std::vector<BallPair> pairs;
+  for (const BallPair& pair : start) {
+    if (pair.source >= static_cast<int>(source_.balls().size()) || pair.target >= static_cast<int>(target_.balls().size()))
+      contract_error("MorphOracle::evaluate: a start pair past a side's last ball");
+    if (pair.source >= 0 && pair.target >= 0) pairs.push_back(pair);
+  }
+  if (pairs.empty() || t == 0 || t == 1 || !x.allFinite()) return evaluate(x, t);
+  return solve_from(x, t, std::move(pairs));
+}
+
+// The pair solve from `pairs` (0 < t < 1), which grow by the violators the
+// KKT check finds until none is left.
+MorphOracleResult MorphOracle::solve_from(const Eigen::Vector3d& x, double t, std::vector<BallPair> pairs) const {
   const double s = source_.shrink();
   const std::vector<Ball>& A = source_.balls();
   const std::vector<Ball>& B = target_.balls();
   const Problem side_a{A, s, x}, side_b{B, s, x};
-  // Candidates: every pair of a few balls of least power on each side (four:
-  // the pairs grow as the square, and fewer cost more rounds).
-  std::vector<BallPair> pairs;
-  for (int i : least_power(*source_.grid_, A, x, 4))
-    for (int j : least_power(*target_.grid_, B, x, 4)) pairs.push_back({i, j});
   MorphOracleResult out;
   for (int round = 0; round < 50; ++round) {
     const std::vector<Ball> balls = interpolated_balls(A, B, pairs, t);

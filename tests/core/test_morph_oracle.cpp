@@ -89,6 +89,38 @@ TEST_CASE("morph oracle: the complex of the live pairs of B(t) has the frame's s
   }
 }
 
+TEST_CASE("morph oracle: started from the pairs of a point's overlay cell, it gives the answer it gives alone",
+          "[oracle][morph]") {
+  // The start only changes where the pair solve begins: from the live pairs
+  // of the cell of B(t)'s complex holding the point, from one far pair, from
+  // none, the answer is the same, certified against all m x n pairs.
+  const auto m1 = test::centred_model(test::data_file("2k39_3models.pdb"), 1);
+  const auto m3 = test::centred_model(test::data_file("2k39_3models.pdb"), 3);
+  const MorphOracle morph(m1, m3, 0.5);
+  const std::vector<BallPair> live = live_pairs(m1, m3);
+  long compared = 0;
+  for (double t : {0.2, 0.5, 0.8}) {
+    const SkinComplex complex = build_skin_complex(interpolated_balls(m1, m3, live, t), {0.5});
+    for (const Eigen::Vector3d& x : points_between(m1, m3, t, 500, 23)) {
+      const MorphOracleResult plain = morph.evaluate(x, t);
+      REQUIRE(plain.certified);
+      std::vector<BallPair> cell_pairs;
+      for (int k : complex.cell(complex.locate(x)).balls)
+        if (k >= 0) cell_pairs.push_back(live[static_cast<size_t>(k)]);
+      for (const std::vector<BallPair>& start : {cell_pairs, std::vector<BallPair>{live.back()}, std::vector<BallPair>{}}) {
+        const MorphOracleResult o = morph.evaluate(x, t, start);
+        INFO("t = " << t << ", " << start.size() << " start pairs");
+        CHECK(o.certified);
+        CHECK(std::abs(o.value - plain.value) <= 1e-12 * (1 + std::abs(plain.value)));
+        CHECK((o.gradient - plain.gradient).norm() <= 1e-10 * (1 + plain.gradient.norm()));
+        ++compared;
+      }
+    }
+  }
+  CHECK(compared == 3 * 500 * 3);
+  CHECK_THROWS_AS(morph.evaluate(Eigen::Vector3d::Zero(), 0.5, {BallPair{static_cast<int>(m1.size()), 0}}), ContractError);
+}
+
 namespace {
 
 // Points on the skin of `balls`, by bisection of the skin oracle's sign along

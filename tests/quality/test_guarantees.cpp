@@ -68,11 +68,11 @@ TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where bro
     CHECK(skipped.all_hold());
   }
   SECTION("the skin given by another oracle: its distances, and the complex where it does not certify") {
-    SkinReference skin{balls, 0.5, [](const Eigen::Vector3d&) { return SkinDistance{0.02, true}; }, {}, {}};
+    SkinReference skin{balls, 0.5, [](const Eigen::Vector3d&, const OracleStart&) { return SkinDistance{0.02, true}; }, {}, {}};
     const GuaranteeReport off = check_guarantees(r.mesh, skin);
     CHECK(off.surface_error.max == 0.02);
     CHECK_FALSE(off.on_skin);
-    skin.oracle = [](const Eigen::Vector3d&) { return SkinDistance{5.0, false}; };
+    skin.oracle = [](const Eigen::Vector3d&, const OracleStart&) { return SkinDistance{5.0, false}; };
     const GuaranteeReport measured = check_guarantees(r.mesh, skin);
     CHECK(measured.surface_error.uncertified == static_cast<long>(r.mesh.vertices.size()));
     CHECK(measured.surface_error.max <= 1e-9);  // on the complex built from scratch, not the oracle's 5 A

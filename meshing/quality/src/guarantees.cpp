@@ -3,8 +3,6 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
@@ -20,18 +18,9 @@ namespace {
 SurfaceError distances(const std::vector<Eigen::Vector3d>& vertices, const SkinReference& skin) {
   std::optional<SkinOracle> own_oracle;
   if (!skin.oracle) own_oracle.emplace(skin.balls, skin.shrink);
-  std::vector<SkinDistance> d;
-  if (own_oracle && skin.starts.size() == vertices.size()) {
-    d.resize(vertices.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t v = r.begin(); v != r.end(); ++v) {
-        const OracleResult o = own_oracle->evaluate(vertices[v], skin.starts[v]);
-        d[v] = SkinDistance{o.distance(), o.certified};
-      }
-    });
-  } else {
-    d = oracle_distances(vertices, skin.oracle ? skin.oracle : point_oracle(*own_oracle));
-  }
+  const std::vector<SkinDistance> d =
+      oracle_distances(vertices, skin.oracle ? skin.oracle : point_oracle(*own_oracle),
+                       skin.starts.size() == vertices.size() ? skin.starts : std::vector<OracleStart>{});
   std::vector<double> off(d.size());
   SurfaceError e;
   for (size_t v = 0; v < d.size(); ++v) {

@@ -2,6 +2,7 @@
 // docs/math.md section 2 (never by the mixed complex the mesher used).
 #include "skinmesh/quality/on_surface_error.hpp"
 
+#include "skinmesh/core/error.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 
 #include <tbb/blocked_range.h>
@@ -12,16 +13,19 @@
 namespace skinmesh {
 
 PointOracle point_oracle(const SkinOracle& oracle) {
-  return [&oracle](const Eigen::Vector3d& x) {
-    const OracleResult o = oracle.evaluate(x);
+  return [&oracle](const Eigen::Vector3d& x, const OracleStart& start) {
+    const OracleResult o = oracle.evaluate(x, start);
     return SkinDistance{o.distance(), o.certified};
   };
 }
 
-std::vector<SkinDistance> oracle_distances(const std::vector<Eigen::Vector3d>& vertices, const PointOracle& oracle) {
+std::vector<SkinDistance> oracle_distances(const std::vector<Eigen::Vector3d>& vertices, const PointOracle& oracle,
+                                           const std::vector<OracleStart>& starts) {
+  if (!starts.empty() && starts.size() != vertices.size())
+    contract_error("oracle_distances: one start per vertex, or none");
   std::vector<SkinDistance> out(vertices.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v) out[v] = oracle(vertices[v]);
+    for (size_t v = r.begin(); v != r.end(); ++v) out[v] = oracle(vertices[v], starts.empty() ? kNoStart : starts[v]);
   });
   return out;
 }

@@ -87,9 +87,16 @@ class MorphOracle {
   MorphOracle(std::vector<Ball> source, std::vector<Ball> target, double shrink);
   // t in [0, 1]; throws ContractError outside.
   MorphOracleResult evaluate(const Eigen::Vector3d& x, double t) const;
+  // The same, with the pair solve started from `start` (e.g. the pairs of
+  // the overlay cell a frame's vertex lies in) instead of the pairs of a few
+  // balls of least power on each side; certified against every pair either
+  // way. At t = 0 or 1, and with no pair, as evaluate(x, t). Throws
+  // ContractError for a ball index past a side's last ball.
+  MorphOracleResult evaluate(const Eigen::Vector3d& x, double t, const std::vector<BallPair>& start) const;
 
  private:
   SkinOracle source_, target_;
+  MorphOracleResult solve_from(const Eigen::Vector3d& x, double t, std::vector<BallPair> pairs) const;
 };
 
 }  // namespace skinmesh

@@ -17,7 +17,6 @@
 
 #include <Eigen/Core>
 
-#include <array>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -32,11 +31,10 @@ struct SkinReference {
   double shrink = 0.5;
   // The oracle; empty: the static oracle of `balls` (SkinOracle).
   PointOracle oracle;
-  // Per vertex, or empty: the balls where the static oracle's solve starts
-  // at it (SkinOracle::evaluate with a start; a mesher's vertex: the balls
-  // of its mixed cell). The oracle certifies its answer against every ball
-  // whatever the start: a good one only makes it faster.
-  std::vector<std::array<int, 4>> starts;
+  // Per vertex, or empty: where the oracle's solve starts at it
+  // (OracleStart, indices into `balls`; a mesher's vertex: its mixed cell's
+  // balls). The oracle certifies its answer whatever the start.
+  std::vector<OracleStart> starts;
   // The skin's topology when the caller has counted it already, by
   // skin_topology on these same balls (the moving-balls engine does at every
   // step); empty: counted here.

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <functional>
 #include <vector>
 
@@ -25,13 +26,21 @@ struct SkinDistance {
   double distance = 0;
   bool certified = false;
 };
-using PointOracle = std::function<SkinDistance(const Eigen::Vector3d&)>;
+// Where an oracle's solve starts at a point: up to four of the skin's balls
+// (indices, -1 for none; a mesher's vertex: the balls of its mixed cell).
+// An oracle certifies its answer whatever the start: a good one only makes
+// it faster.
+using OracleStart = std::array<int, 4>;
+inline constexpr OracleStart kNoStart{{-1, -1, -1, -1}};
+using PointOracle = std::function<SkinDistance(const Eigen::Vector3d&, const OracleStart&)>;
 
 // The static oracle (docs/math.md section 2) as a PointOracle; `oracle` must outlive it.
 PointOracle point_oracle(const SkinOracle& oracle);
 
-// Per vertex, its distance by `oracle`, in parallel over the vertices.
-std::vector<SkinDistance> oracle_distances(const std::vector<Eigen::Vector3d>& vertices, const PointOracle& oracle);
+// Per vertex, its distance by `oracle`, in parallel over the vertices;
+// `starts`: per vertex, or empty (kNoStart for every vertex).
+std::vector<SkinDistance> oracle_distances(const std::vector<Eigen::Vector3d>& vertices, const PointOracle& oracle,
+                                           const std::vector<OracleStart>& starts = {});
 
 // The static oracle's distances (SkinOracle), summarised; in parallel over the vertices.
 SurfaceError on_surface_error(const std::vector<Eigen::Vector3d>& vertices, const std::vector<Ball>& balls,
