@@ -647,24 +647,40 @@ namespace {
 // the new sphere's centre, at half its size, inside it, so that the
 // gradient leads out to the sphere. Seeds within 1e-6 A of another are
 // left out.
+// Skin points projected from `change`'s apex (with_apex) and from six
+// points along the axes `offset` away from it, from its cell.
+std::vector<SkinSample> skin_points_around(const SkinComplex& complex, const TopologyChange& change, double offset,
+                                           bool with_apex) {
+  std::vector<SkinSample> out;
+  for (int k = with_apex ? -1 : 0; k < 6; ++k) {
+    Eigen::Vector3d from = change.point;
+    if (k >= 0) from[k / 2] += (k % 2 ? -1 : 1) * offset;
+    const Projection p = complex.project(from, change.cell, 1e-14);
+    if (p.converged) out.push_back({p.point, p.cell});
+  }
+  return out;
+}
+
+// Adds `points` to `into` but those within 1e-6 A of one already added
+// after its first `own` entries.
+void add_distinct(const std::vector<SkinSample>& points, size_t own, std::vector<SkinSample>& into) {
+  for (const SkinSample& p : points) {
+    const bool known = std::any_of(into.begin() + static_cast<long>(own), into.end(),
+                                   [&](const SkinSample& q) { return (q.point - p.point).norm() < 1e-6; });
+    if (!known) into.push_back(p);
+  }
+}
+
 SurfaceMesh with_birth_seeds(const SkinComplex& complex, const SurfaceMesh& mesh,
                              const std::vector<TopologyChange>& changes) {
+  std::vector<SkinSample> seeds;
+  for (const TopologyChange& c : changes)
+    if (c.birth) add_distinct(skin_points_around(complex, c, 0.5 * c.size, false), 0, seeds);
   SurfaceMesh seeded = mesh;
-  for (const TopologyChange& c : changes) {
-    if (!c.birth) continue;
-    for (int k = 0; k < 6; ++k) {
-      Eigen::Vector3d from = c.point;
-      from[k / 2] += (k % 2 ? -0.5 : 0.5) * c.size;
-      const Projection p = complex.project(from, c.cell, 1e-14);
-      if (!p.converged) continue;
-      const bool known = std::any_of(seeded.vertices.begin() + static_cast<long>(mesh.vertices.size()),
-                                     seeded.vertices.end(),
-                                     [&](const Eigen::Vector3d& q) { return (q - p.point).norm() < 1e-6; });
-      if (known) continue;
-      seeded.vertices.push_back(p.point);
-      seeded.cells.push_back(p.cell);
-      seeded.normals.push_back(complex.evaluate(p.point, p.cell).gradient.normalized());
-    }
+  for (const SkinSample& p : seeds) {
+    seeded.vertices.push_back(p.point);
+    seeded.cells.push_back(p.cell);
+    seeded.normals.push_back(complex.evaluate(p.point, p.cell).gradient.normalized());
   }
   return seeded;
 }
@@ -817,6 +833,13 @@ RepairResult whole_context_patch(const SkinComplex& complex, const SurfaceMesh& 
 // A local context first (PatchPolicy::local_context_first); when that
 // fails, the whole region's measure, unless the local patch already took
 // nearly the whole frame (a larger context would too).
+std::vector<SkinSample> seeds_at_changes(const SkinComplex& complex, const std::vector<TopologyChange>& changes) {
+  std::vector<SkinSample> seeds;
+  for (const TopologyChange& c : changes)
+    add_distinct(skin_points_around(complex, c, std::max(0.5 * c.size, 1e-3), true), 0, seeds);
+  return seeds;
+}
+
 RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {

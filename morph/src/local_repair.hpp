@@ -47,6 +47,16 @@ struct LocalRepairOptions {
   long euler_change = 0;
 };
 
+// Skin points around the places where the topology changed, for a whole
+// frame remeshed from its vertices (remesh_from_vertices' seeds): from each
+// change's apex and from six points along the axes half its size (at least
+// 1e-3 A) away, projected onto the skin. A neck that opened within the step
+// can be too thin for any vertex to lie on it; refinement started from
+// transported vertices then closed it again (the frame's Euler
+// characteristic off by two), where these points make it resolve the neck.
+// Points within 1e-6 A of one another are kept once.
+std::vector<SkinSample> seeds_at_changes(const SkinComplex& complex, const std::vector<TopologyChange>& changes);
+
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on
 // the skin of `complex` (all zero is fine when options.changes is not
 // empty). The patch is refined to `repair` (stricter, for room before the

@@ -81,14 +81,18 @@ double density_over_fresh(const SkinComplex& complex, const SurfaceMesh& mesh, c
 }
 
 RepairResult remesh_from_vertices(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
-                                  const MeshingOptions& criteria) {
+                                  const MeshingOptions& criteria, const std::vector<SkinSample>& seeds) {
   std::vector<SkinSample> samples;
-  std::vector<long> sample_vertex;  // per sample: its vertex in `mesh`
-  samples.reserve(mesh.vertices.size());
+  std::vector<long> sample_vertex;  // per sample: its vertex in `mesh`, -1 for a seed
+  samples.reserve(mesh.vertices.size() + seeds.size());
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     if (drop[v]) continue;
     samples.push_back({mesh.vertices[v], mesh.cells[v]});
     sample_vertex.push_back(static_cast<long>(v));
+  }
+  for (const SkinSample& seed : seeds) {
+    samples.push_back(seed);
+    sample_vertex.push_back(-1);
   }
   SkinMeshResult made = remesh_skin(complex, samples, criteria);
   RepairResult out;

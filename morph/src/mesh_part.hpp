@@ -37,7 +37,9 @@ double density_over_fresh(const SkinComplex& complex, const SurfaceMesh& mesh, c
 // The frame remeshed from its vertices not marked in `drop` (remesh_skin);
 // `origin` maps the result's vertices to `mesh`'s. Not ok (the mesher's
 // message in failed_because) when the mesher cannot.
+// `seeds`: more skin points to start from, none of them a vertex of `mesh`
+// (new vertices, origin -1).
 RepairResult remesh_from_vertices(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& drop,
-                                  const MeshingOptions& criteria);
+                                  const MeshingOptions& criteria, const std::vector<SkinSample>& seeds = {});
 
 }  // namespace skinmesh::detail

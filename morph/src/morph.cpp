@@ -89,8 +89,10 @@ struct Morph::Impl {
   bool too_dense(const SkinComplex& next, const SurfaceMesh& mesh) const;
   void rebuild_thinned(const SkinComplex& next, double t);
   void rebuild(const SkinComplex& next, const MeshingOptions& criteria, double t);
-  void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
-  bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop);
+  void remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop,
+                         const std::vector<SkinSample>& seeds = {});
+  bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop,
+              const std::vector<SkinSample>& seeds);
   long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                      std::vector<char>& drop);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
@@ -256,10 +258,11 @@ long Morph::Impl::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std
   return r.left;
 }
 
-// Remeshes the frame from the transported vertices not dropped; false when
-// the mesher cannot (then the caller rebuilds from scratch).
-bool Morph::Impl::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
-  detail::RepairResult r = detail::remesh_from_vertices(next, moved, drop, options_.repair_criteria());
+// Remeshes the frame from the transported vertices not dropped and `seeds`;
+// false when the mesher cannot (then the caller rebuilds from scratch).
+bool Morph::Impl::repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop,
+                         const std::vector<SkinSample>& seeds) {
+  detail::RepairResult r = detail::remesh_from_vertices(next, moved, drop, options_.repair_criteria(), seeds);
   if (!r.ok) return false;
   const long kept = std::count_if(r.origin.begin(), r.origin.end(), [](long o) { return o >= 0; });
   detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);
@@ -309,14 +312,25 @@ void Morph::Impl::reseat(const SkinComplex& next, FrameStats& stats) {
 // (skin_topology.hpp) beside the remesh: refinement from transported
 // vertices can close a thin handle that seeds and refinement from scratch
 // keep. Throws Error when the mesh from scratch is not certified either.
-void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop) {
+void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop,
+                                    const std::vector<SkinSample>& seeds) {
   SkinTopology skin;
   tbb::task_group counting;
   counting.run([&] { skin = skin_topology(next.balls()); });
   const long before = static_cast<long>(frame_.ids.size());
-  const bool remeshed = repair(next, moved, drop);
+  const std::vector<long> ids = frame_.ids;  // of `moved`'s vertices, for a second remesh
+  bool remeshed = repair(next, moved, drop, {});
   if (remeshed && remesh_fault_) remesh_fault_(frame_.mesh, frame_.ids);
   counting.wait();
+  // A neck that opened can be too thin for any vertex to lie on: the remesh
+  // then closes it. Seeded at the topology changes, it resolves them
+  // (seeding every remesh made larger meshes where it was not needed).
+  if ((!remeshed || mesh_topology(frame_.mesh) != skin) && !seeds.empty()) {
+    frame_.ids = ids;
+    remeshed = repair(next, moved, drop, seeds);
+    if (remeshed && remesh_fault_) remesh_fault_(frame_.mesh, frame_.ids);
+    frame_.stats.remeshed_because += "; remeshed again with seeds at the topology changes";
+  }
   if (remeshed) {
     const SkinTopology made = mesh_topology(frame_.mesh);
     if (made == skin) return;
@@ -510,7 +524,7 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
       before_remesh();
       frame_.stats.crowded =
           detail::mark_crowded(next, moved.mesh, options_.frames, options_.repair.crowded_below, moved.drop);
-      remesh_or_rebuild(next, moved.mesh, moved.drop);
+      remesh_or_rebuild(next, moved.mesh, moved.drop, detail::seeds_at_changes(next, local.changes));
     }
   }
   // Counted by ids, as vertices an edit inserted may be gone again after

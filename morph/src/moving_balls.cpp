@@ -513,10 +513,11 @@ struct MovingBalls::Impl {
   std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved, const std::vector<char>& settled);
   std::string mend_locally(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
                            SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed,
-                           std::vector<char> settled);
+                           std::vector<char> settled, detail::LocalRepairOptions& local);
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
                      SurfaceMesh& moved, std::vector<char>& lost, std::vector<char>& settled, long& euler_change);
-  bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria);
+  bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria,
+              const std::vector<SkinSample>& seeds);
   MeshingOptions repair_criteria() const { return options_.frames; }
 
   MovingOptions options_;
@@ -695,14 +696,25 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
 void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
                          SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed,
                          std::vector<char> settled) {
-  const std::string because = mend_locally(next, topology, critical, moved, lost, stayed, std::move(settled));
+  detail::LocalRepairOptions local;  // the step's topology changes, among them
+  const std::string because = mend_locally(next, topology, critical, moved, lost, stayed, std::move(settled), local);
   all_passed_ = because.empty();
   if (because.empty()) return;
   FrameStats& s = frame_.stats;
   s.remeshed_because = because;
   const auto stage = Clock::now();
   s.crowded += detail::mark_crowded(next, moved, options_.frames, options_.repair.crowded_below, lost);
-  const bool remeshed = remesh(next, moved, lost, repair_criteria());
+  const std::vector<long> ids = frame_.ids;  // of `moved`'s vertices, for a second remesh
+  bool remeshed = remesh(next, moved, lost, repair_criteria(), {});
+  // A neck that opened in the step can be too thin for any vertex to lie
+  // on: the remesh then closes it. Seeded at the step's topology changes,
+  // it resolves them (seeding every remesh made larger meshes where it was
+  // not needed).
+  if ((!remeshed || mesh_topology(frame_.mesh) != topology) && !local.changes.empty()) {
+    frame_.ids = ids;
+    remeshed = remesh(next, moved, lost, repair_criteria(), detail::seeds_at_changes(next, local.changes));
+    s.remeshed_because += "; remeshed again with seeds at the topology changes";
+  }
   if (!remeshed || mesh_topology(frame_.mesh) != topology) {
     SkinMeshResult made = mesh_skin(next, repair_criteria());
     if (made.status != MeshingStatus::ok)
@@ -739,16 +751,16 @@ std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, Su
 // Judging, relaxation, edits and a local patch (moving_balls.hpp). Returns
 // "" when they made a certified frame, else why the step must be remeshed
 // whole; `moved` and `lost` are then the mesh to remesh from and its lost
-// vertices.
+// vertices, and `local` holds the step's topology changes.
 std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinTopology& topology,
                                       const std::vector<int>& critical, SurfaceMesh& moved, std::vector<char>& lost,
-                                      const std::vector<char>& stayed, std::vector<char> settled) {
+                                      const std::vector<char>& stayed, std::vector<char> settled,
+                                      detail::LocalRepairOptions& local) {
   FrameStats& s = frame_.stats;
   // Where the topology changed; a component or void that vanished is
   // dropped first (its sphere of triangles has no skin left to go to); one
   // that is not a component of its own in the step before becomes a place
   // of the local patch, whose Euler characteristic is checked.
-  detail::LocalRepairOptions local;
   local.crowded_below = options_.repair.crowded_below;
   local.policy = options_.repair.patch;
   std::vector<detail::VanishingSphere> vanished;
@@ -842,11 +854,11 @@ void inject_certificate_fault(MovingBalls& engine, std::function<void(SurfaceMes
 
 }  // namespace detail
 
-// The whole step remeshed from the moved vertices not dropped (remesh_skin);
-// false when the mesher cannot.
+// The whole step remeshed from the moved vertices not dropped and `seeds`
+// (remesh_skin); false when the mesher cannot.
 bool MovingBalls::Impl::remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop,
-                               const MeshingOptions& criteria) {
-  detail::RepairResult r = detail::remesh_from_vertices(next, moved, drop, criteria);
+                               const MeshingOptions& criteria, const std::vector<SkinSample>& seeds) {
+  detail::RepairResult r = detail::remesh_from_vertices(next, moved, drop, criteria, seeds);
   if (!r.ok) return false;
   detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);
   frame_.mesh = std::move(r.mesh);

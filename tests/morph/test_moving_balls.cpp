@@ -343,6 +343,51 @@ TEST_CASE("moving balls: a patch's new triangles pass the frame judge next to ne
   }
 }
 
+TEST_CASE("moving balls: a step remeshed whole across a neck that opened keeps the skin's topology and its ids",
+          "[moving]") {
+  // 3mht's chain A with residues 187-304 turning 0.2 degrees a frame about
+  // the axis through the CA atoms of residues 186 and 305, as the frames of
+  // a PDB trajectory hold them (coordinates to 1e-3 A). At frame 8 necks
+  // open where the domains meet (the skin's Euler characteristic rises by
+  // 4), the local patch fails, and the step is remeshed whole from its
+  // vertices; the remesh closed a neck of size 0.03 A that no vertex lay on
+  // (Euler characteristic two short), and the frame was meshed from
+  // scratch, every id new. Seeded with skin points around the step's
+  // topology changes, the remesh resolves the necks.
+  const Molecule m = read_molecule(test::data_file("3mht.pdb"));
+  const std::vector<Ball> all = balls_from_molecule(m, 0.5);
+  std::vector<Ball> start;
+  std::vector<char> moving;
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero(), end = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < m.atoms.size(); ++i) {
+    const Atom& a = m.atoms[i];
+    if (a.chain != "A") continue;
+    start.push_back(all[i]);
+    moving.push_back(a.residue_number >= 187 && a.residue_number <= 304);
+    if (a.name == "CA" && a.residue_number == 186) pivot = a.position;
+    if (a.name == "CA" && a.residue_number == 305) end = a.position;
+  }
+  const auto frame_balls = [&](int k) {
+    std::vector<Ball> balls = hinged(start, moving, pivot, end - pivot, 0.2 * k);
+    for (Ball& b : balls)
+      for (int c = 0; c < 3; ++c) b.center[c] = std::round(b.center[c] * 1000) / 1000;
+    return balls;
+  };
+  MovingBalls engine(frame_balls(0));
+  for (int k = 1; k <= 8; ++k) engine.advance_to(frame_balls(k), k);
+  const MorphFrame& f = engine.frame();
+  const SkinTopology before = skin_topology(frame_balls(7)), after = skin_topology(frame_balls(8));
+  INFO("frame 8: remeshed " << f.stats.remeshed << " (" << f.stats.remeshed_because << "), from scratch "
+                            << f.stats.full_rebuild << ", ids kept " << f.stats.ids_kept);
+  // The premise: the skin's topology changed in the step and it was remeshed whole.
+  REQUIRE(after.euler != before.euler);
+  REQUIRE(f.stats.remeshed);
+  CHECK_FALSE(f.stats.full_rebuild);
+  CHECK(f.stats.ids_kept >= 0.9);
+  CHECK(f.stats.topology_certified);
+  CHECK(mesh_topology(f.mesh) == after);
+}
+
 TEST_CASE("moving balls: atoms on one side only grow out of and shrink into their anchor", "[moving]") {
   ReadOptions read;
   const Molecule full = read_molecule(test::data_file("pept.pdb"), read);
