@@ -499,7 +499,6 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
                 << json_text(line) << "\n";
       return false;
     }
-    stage_frame(out.outputs, out.dir, pending, out.files);
     out.lines << json_text(line, JsonLayout::one_line) << "\n";
     out.counts.add(line);
     pace.done_one();
@@ -511,8 +510,9 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
     BlendFrame made = snapshot_blend(morph, k, times[k]);
     if (k > 0 && !finish()) return false;
     pending = std::move(made);
-    checking.run([&] {
+    checking.run([&] {  // the check, then the frame's files, beside the next frame
       check = check_blend_frame(pending.frame.mesh, pending.starts, reference, pending.t, min_angle, self_intersections);
+      if (check.holds()) stage_frame(out.outputs, out.dir, pending, out.files);
     });
   }
   return finish();

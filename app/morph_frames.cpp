@@ -309,7 +309,8 @@ void stage_moving_frame(OutputSet& outputs, const OutputDirectory& dir, const Ma
 
 // Frame k is checked and written while frame k+1 is made: the engine's
 // repairs are mostly serial and the check (grading, the oracle at every
-// vertex, the exact self-intersection test) runs beside them.
+// vertex, the exact self-intersection test) and the staging of the frame's
+// files run beside them, one frame's after the other's.
 MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files, OutputSet& outputs,
                                      const OutputDirectory& dir, std::ostream& lines) {
   MovingFramesResult result;
@@ -323,7 +324,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
   MadeFrame pending;
   FrameCheck check;
   tbb::task_group checking;
-  // Waits for the pending frame's check, then writes it; false when it failed.
+  // Waits for the pending frame's check and files, then records its line; false when it failed.
   const auto finish = [&]() {
     checking.wait();
     const FrameStats& st = pending.frame.stats;
@@ -333,7 +334,6 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
       result.failed_index = pending.index;
       return false;
     }
-    stage_moving_frame(outputs, dir, pending, run, files);
     lines << json_text(line, JsonLayout::one_line) << "\n";
     result.counts.add(line);
     if (pending.index > 0) {
@@ -349,7 +349,10 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
     MadeFrame made = snapshot(moving, k);
     if (k > 0 && !finish()) return result;
     pending = std::move(made);
-    checking.run([&] { check = check_moving_frame(pending, run.options.frames.min_angle, run.self_intersections); });
+    checking.run([&] {
+      check = check_moving_frame(pending, run.options.frames.min_angle, run.self_intersections);
+      if (check.holds()) stage_moving_frame(outputs, dir, pending, run, files);
+    });
   }
   if (!finish()) return result;
   if (run.progress) run.progress->finish();
