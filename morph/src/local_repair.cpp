@@ -483,7 +483,8 @@ struct SoFar {
 };
 
 // `seeds`: the mesh's vertices in [first, second) that no triangle uses
-// are seeds on a newborn component, interior to the patch.
+// are seeds at topology changes (a newborn component, a neck), interior to
+// the patch.
 Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
                   const std::vector<char>& region, std::pair<size_t, size_t> seeds, const SoFar& so_far,
                   const MeshingOptions& repair, const MeshingOptions& accept, const LocalRepairOptions& options) {
@@ -671,11 +672,15 @@ void add_distinct(const std::vector<SkinSample>& points, size_t own, std::vector
   }
 }
 
-SurfaceMesh with_birth_seeds(const SkinComplex& complex, const SurfaceMesh& mesh,
-                             const std::vector<TopologyChange>& changes) {
+// The mesh with skin points around every topology change added as vertices
+// no triangle uses yet: a component or void born in the step has no vertex
+// on it, and a neck that opened can be too thin for any (events.hpp); from
+// these the patch meshes them.
+SurfaceMesh with_seeds_at_changes(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                  const std::vector<TopologyChange>& changes) {
   std::vector<SkinSample> seeds;
   for (const TopologyChange& c : changes)
-    if (c.birth) add_distinct(skin_points_around(complex, c, 0.5 * c.size, false), 0, seeds);
+    add_distinct(skin_points_around(complex, c, std::max(0.5 * c.size, 1e-3), !c.birth), 0, seeds);
   SurfaceMesh seeded = mesh;
   for (const SkinSample& p : seeds) {
     seeded.vertices.push_back(p.point);
@@ -722,8 +727,8 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
                             const LocalRepairOptions& options, Retry retry, double local_scale,
                             PiecesFailure& failure) {
   RepairResult out;
-  // The frame as the patch's pieces go into it, with seeds on newborn components.
-  SurfaceMesh mesh = with_birth_seeds(complex, given, options.changes);
+  // The frame as the patch's pieces go into it, with seeds at the topology changes.
+  SurfaceMesh mesh = with_seeds_at_changes(complex, given, options.changes);
   const std::pair<size_t, size_t> seeds{given.vertices.size(), mesh.vertices.size()};
   auto stars = std::make_unique<VertexStars>(mesh);
   std::vector<char> region = failing;

@@ -28,10 +28,11 @@ namespace skinmesh::detail {
 struct TopologyChange {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double radius = 0;  // Angstrom
-  // A component or a void born there (no vertex lies on it yet): the patch
-  // is seeded with skin points found from around `point`, the centre of
-  // the new sphere, at half of `size` (sqrt|R2|, about its radius), in
-  // `cell` of the complex.
+  // The patch is seeded with skin points found from six points half of
+  // `size` (sqrt|R2|, at least 1e-3 A) away from `point` along the axes, in
+  // `cell` of the complex, and, but for a birth, from `point` itself. A
+  // birth: a component or a void born there, `point` the centre of the new
+  // sphere (no vertex lies on it yet).
   bool birth = false;
   double size = 0;  // Angstrom
   int cell = -1;
