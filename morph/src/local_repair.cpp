@@ -676,11 +676,20 @@ void add_distinct(const std::vector<SkinSample>& points, size_t own, std::vector
 // no triangle uses yet: a component or void born in the step has no vertex
 // on it, and a neck that opened can be too thin for any (events.hpp); from
 // these the patch meshes them.
-SurfaceMesh with_seeds_at_changes(const SkinComplex& complex, const SurfaceMesh& mesh,
-                                  const std::vector<TopologyChange>& changes) {
+// Skin points around each change: from six points half its size (at least
+// 1e-3 A) away along the axes, and from its apex unless it is a birth and
+// `apex_of_births` is false (a birth's apex is the new sphere's centre).
+std::vector<SkinSample> points_at_changes(const SkinComplex& complex, const std::vector<TopologyChange>& changes,
+                                          bool apex_of_births) {
   std::vector<SkinSample> seeds;
   for (const TopologyChange& c : changes)
-    add_distinct(skin_points_around(complex, c, std::max(0.5 * c.size, 1e-3), !c.birth), 0, seeds);
+    add_distinct(skin_points_around(complex, c, std::max(0.5 * c.size, 1e-3), apex_of_births || !c.birth), 0, seeds);
+  return seeds;
+}
+
+SurfaceMesh with_seeds_at_changes(const SkinComplex& complex, const SurfaceMesh& mesh,
+                                  const std::vector<TopologyChange>& changes) {
+  const std::vector<SkinSample> seeds = points_at_changes(complex, changes, false);
   SurfaceMesh seeded = mesh;
   for (const SkinSample& p : seeds) {
     seeded.vertices.push_back(p.point);
@@ -835,15 +844,13 @@ RepairResult whole_context_patch(const SkinComplex& complex, const SurfaceMesh& 
 
 }  // namespace
 
+std::vector<SkinSample> seeds_at_changes(const SkinComplex& complex, const std::vector<TopologyChange>& changes) {
+  return points_at_changes(complex, changes, true);
+}
+
 // A local context first (PatchPolicy::local_context_first); when that
 // fails, the whole region's measure, unless the local patch already took
 // nearly the whole frame (a larger context would too).
-std::vector<SkinSample> seeds_at_changes(const SkinComplex& complex, const std::vector<TopologyChange>& changes) {
-  std::vector<SkinSample> seeds;
-  for (const TopologyChange& c : changes)
-    add_distinct(skin_points_around(complex, c, std::max(0.5 * c.size, 1e-3), true), 0, seeds);
-  return seeds;
-}
 
 RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
