@@ -643,11 +643,6 @@ long put_in(const SkinComplex& complex, SurfaceMesh& mesh, std::vector<char>& re
 
 namespace {
 
-// The mesh with seed vertices (no triangles) on each component or void
-// born since the last frame: skin points projected from six points around
-// the new sphere's centre, at half its size, inside it, so that the
-// gradient leads out to the sphere. Seeds within 1e-6 A of another are
-// left out.
 // Skin points projected from `change`'s apex (with_apex) and from six
 // points along the axes `offset` away from it, from its cell.
 std::vector<SkinSample> skin_points_around(const SkinComplex& complex, const TopologyChange& change, double offset,
@@ -672,13 +667,11 @@ void add_distinct(const std::vector<SkinSample>& points, size_t own, std::vector
   }
 }
 
-// The mesh with skin points around every topology change added as vertices
-// no triangle uses yet: a component or void born in the step has no vertex
-// on it, and a neck that opened can be too thin for any (events.hpp); from
-// these the patch meshes them.
 // Skin points around each change: from six points half its size (at least
 // 1e-3 A) away along the axes, and from its apex unless it is a birth and
-// `apex_of_births` is false (a birth's apex is the new sphere's centre).
+// `apex_of_births` is false (a birth's apex is the new sphere's centre, and
+// the six points inside the new sphere lead out to it). Points within
+// 1e-6 A of another are left out.
 std::vector<SkinSample> points_at_changes(const SkinComplex& complex, const std::vector<TopologyChange>& changes,
                                           bool apex_of_births) {
   std::vector<SkinSample> seeds;
@@ -687,6 +680,10 @@ std::vector<SkinSample> points_at_changes(const SkinComplex& complex, const std:
   return seeds;
 }
 
+// The mesh with skin points around every topology change added as vertices
+// no triangle uses yet: a component or void born in the step has no vertex
+// on it, and a neck that opened can be too thin for any (events.hpp); from
+// these the patch meshes them.
 SurfaceMesh with_seeds_at_changes(const SkinComplex& complex, const SurfaceMesh& mesh,
                                   const std::vector<TopologyChange>& changes) {
   const std::vector<SkinSample> seeds = points_at_changes(complex, changes, false);
@@ -851,7 +848,6 @@ std::vector<SkinSample> seeds_at_changes(const SkinComplex& complex, const std::
 // A local context first (PatchPolicy::local_context_first); when that
 // fails, the whole region's measure, unless the local patch already took
 // nearly the whole frame (a larger context would too).
-
 RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
