@@ -368,9 +368,8 @@ MovingOptions moving_options(const MorphOptions& m) {
   o.shrink = m.shrink;
   o.first = m.first;
   o.frames = m.frames;
-  o.first_size_margin = m.first_size_margin;
   o.relaxation = m.relaxation;
-  return o;  // the repair policy stays the moving engine's own (moving_balls.hpp)
+  return o;  // the first frame's size margin and the repair policy stay the moving engine's own (moving_balls.hpp)
 }
 
 // --pairs matched: the atoms travel (matched_motion.hpp), carried by the

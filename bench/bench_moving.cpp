@@ -21,6 +21,7 @@
 // frame's balls.
 //
 //   bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command]
+//                [--first-size-margin X]   (c only: MovingOptions::first_size_margin, default the engine's)
 #include "forked.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/stopwatch.hpp"
@@ -208,11 +209,11 @@ struct Column {
 
 double s_of(int k, int frames) { return static_cast<double>(k) / (frames - 1); }
 
-Column run_engine(const Motion& motion, int frames) {
+Column run_engine(const Motion& motion, int frames, const MovingOptions& options) {
   Column c;
   std::vector<Ball> before = motion.at(0);
   const auto start = Clock::now();
-  MovingBalls moving(before);
+  MovingBalls moving(before, options);
   c.seconds_first = seconds_since(start);
   c.seconds += c.seconds_first;
   c.grade(moving.frame().mesh, before);
@@ -389,6 +390,7 @@ int main(int argc, char** argv) {
   int frames = 101, sample = 5, timeout = 3600;
   std::string only;  // run the motions whose name holds this text
   bool skip_command = false;
+  MovingOptions engine_options;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--only" && i + 1 < argc) only = argv[++i];
@@ -396,8 +398,11 @@ int main(int argc, char** argv) {
     else if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
     else if (a == "--sample" && i + 1 < argc) sample = std::atoi(argv[++i]);
     else if (a == "--timeout" && i + 1 < argc) timeout = std::atoi(argv[++i]);
+    else if (a == "--first-size-margin" && i + 1 < argc) engine_options.first_size_margin = std::atof(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command]\n");
+      std::fprintf(stderr,
+                   "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command] "
+                   "[--first-size-margin X]\n");
       return 2;
     }
   }
@@ -413,7 +418,7 @@ int main(int argc, char** argv) {
     print_json(b);
     rows.push_back(b);
     Row c{motion.name, "c moving balls", motion.atoms,
-          bench::run_forked<Column>(timeout, [&] { return run_engine(motion, frames); })};
+          bench::run_forked<Column>(timeout, [&] { return run_engine(motion, frames, engine_options); })};
     print_json(c);
     rows.push_back(c);
     if (skip_command) continue;

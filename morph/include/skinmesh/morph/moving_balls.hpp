@@ -62,7 +62,12 @@ struct MovingOptions {
     o.min_angle = 20.0;   // degrees
     return o;
   }();
-  double first_size_margin = 0.85;  // the first frame refined to `first` with its sizes times this (room to move)
+  // The first frame refined to `first` with its sizes times this
+  // (dimensionless; below 1 denser). Later frames keep about the first
+  // frame's density (repairs refine to `frames`, nothing thins), so at 1
+  // they hold about as many triangles as a rebuild; the room to move is
+  // the first frame's 30 degrees against the frames' 20.
+  double first_size_margin = 1.0;
   // The largest move of a ball in one internal step (Angstrom): the centre's
   // move plus the change of its radius. A call moving balls farther is
   // split into equal steps. Fewer, longer steps cost less in all: each
