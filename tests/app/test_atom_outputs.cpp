@@ -121,7 +121,7 @@ void check_mesh_atoms(const std::string& molecule, const std::string& args, cons
 }  // namespace
 
 TEST_CASE("mesh writes the atom table beside the mesh and its vertices name its rows, filters and outer-only kept",
-          "[cli][atoms]") {
+          "[cli][atoms][large]") {
   SECTION("hydrogens kept, cavities dropped") {
     ReadOptions read;
     read.keep_hydrogens = true;

@@ -642,7 +642,7 @@ TEST_CASE("skinmesh --version, and reports that say which version wrote them and
   std::system(("rm -rf " + std::string(pattern)).c_str());
 }
 
-TEST_CASE("skinmesh morph --spacing change: frames at equal shares of the largest ball move", "[cli][morph]") {
+TEST_CASE("skinmesh morph --spacing change: frames at equal shares of the largest ball move", "[cli][morph][large]") {
   char pattern[] = "/tmp/skinmesh-spacing-XXXXXX";
   REQUIRE(mkdtemp(pattern) != nullptr);
   const std::string dir = std::string(pattern) + "/out";
@@ -802,7 +802,7 @@ TEST_CASE("an interrupted command leaves no output behind", "[cli][bad][interrup
   }
 }
 
-TEST_CASE("the example at the end of every command's help runs as written", "[cli]") {
+TEST_CASE("the example at the end of every command's help runs as written", "[cli][large]") {
   const std::string data = skinmesh::test::data_file("pept.pdb").substr(0, skinmesh::test::data_file("pept.pdb").rfind('/') + 1);
   skinmesh::test::TempFile holder("x");
   const std::string dir = holder.path() + "-examples";
@@ -825,7 +825,7 @@ TEST_CASE("the example at the end of every command's help runs as written", "[cl
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("mesh --outer-only keeps the outer surface, and the report gives the skin's own area", "[cli][mesh]") {
+TEST_CASE("mesh --outer-only keeps the outer surface, and the report gives the skin's own area", "[cli][mesh][large]") {
   skinmesh::test::TempFile out("outer.ply");
   skinmesh::test::TempFile report("outer.json");
   const Run r = run("--quiet mesh " + skinmesh::test::data_file("1ubi.pdb") + " -o " + out.path() + " --outer-only --report " +

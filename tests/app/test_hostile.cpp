@@ -184,7 +184,7 @@ TEST_CASE("hostile inputs: pept jittered by 1e-6 A keeps the jitter and meshes a
 // pairs was then so nearly degenerate that frames failed their guarantees or
 // the refinement stalled (exit 3); atoms moved less than kUnmovedWithin now
 // count as unmoved, and their pairs leave B(t) as convex combinations.
-TEST_CASE("hostile inputs: all pairs of pept and its copy moved by 1e-9 to 3e-5 A morph and interpolate", "[cli][hostile]") {
+TEST_CASE("hostile inputs: all pairs of pept and its copy moved by 1e-9 to 3e-5 A morph and interpolate", "[cli][hostile][large]") {
   const std::string pept = skinmesh::test::data_file("pept.pdb");
   Folder out;
   const Run reference = run_within(30, "--json mesh " + pept + " -o " + out.path + "/pept.ply");
@@ -218,7 +218,7 @@ TEST_CASE("hostile inputs: all pairs of pept and its copy moved by 1e-9 to 3e-5 
 // 1e-7 refined for minutes. Frames within 1e-5 of an end are refused at once;
 // frames at 1e-5 are made, every vertex certified by the morph oracle (which
 // left 1-2% uncertified there before it solved in the split unknowns).
-TEST_CASE("hostile inputs: m x n frames within 1e-5 of an end are refused at once, at 1e-5 certified", "[cli][hostile]") {
+TEST_CASE("hostile inputs: m x n frames within 1e-5 of an end are refused at once, at 1e-5 certified", "[cli][hostile][large]") {
   const std::string pept = skinmesh::test::data_file("pept.pdb"), al1 = skinmesh::test::data_file("3al1.pdb");
   Folder out;
   for (const char* times : {"1e-7,1", "0,0.9999999,1", "3e-6,0.5"}) {

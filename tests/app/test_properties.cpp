@@ -105,7 +105,7 @@ void check_run(const std::string& args, const std::function<bool(const std::stri
 
 }  // namespace
 
-TEST_CASE("property: morph with drawn times, pairs and options ends cleanly", "[cli][property]") {
+TEST_CASE("property: morph with drawn times, pairs and options ends cleanly", "[cli][property][large]") {
   Draw draw(3901);
   for (int i = 0; i < 10; ++i) {
     const auto [source, target] = draw.one_of(input_pairs());

@@ -108,7 +108,7 @@ std::vector<Ball> molecule_balls(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("mesher guarantees on the shipped molecules", "[mesher]") {
+TEST_CASE("mesher guarantees on the shipped molecules", "[mesher][large]") {
   for (const char* name : {"pept.pdb", "3al1.pdb", "1ubi.pdb"}) check_mesher_guarantees(molecule_balls(data_file(name)), name);
 }
 
@@ -157,7 +157,7 @@ TEST_CASE("mesher guarantees on cospherical and coplanar ball sets", "[mesher][d
   }
 }
 
-TEST_CASE("mesher guarantees on the exact midway sets of two morphs", "[mesher][degenerate][interpolation]") {
+TEST_CASE("mesher guarantees on the exact midway sets of two morphs", "[mesher][degenerate][interpolation][large]") {
   // B(1/2) of pept -> 3al1 and of 2k39 model 1 -> 2, both centred, live
   // pairs, no jitter: groups of balls orthogonal to one sphere everywhere.
   // CGAL's mesher gets these wrong unless the centres are jittered by 1e-9 A
@@ -241,7 +241,7 @@ TEST_CASE("mesher options: uniform edge length, a smaller angle bound, the budge
   CHECK(mesh_skin(complex, fine).status == MeshingStatus::over_budget);
 }
 
-TEST_CASE("an edge-length cap keeps the topology where the skin bends more", "[mesher]") {
+TEST_CASE("an edge-length cap keeps the topology where the skin bends more", "[mesher][large]") {
   // Strictly uniform 1 A triangles lost one of the 68 handles of 1ubi; the
   // cap now yields to the curvature bound there.
   MeshingOptions capped;

@@ -164,7 +164,7 @@ TEST_CASE("extreme legal inputs are refused at once with the estimate", "[estima
 }
 
 TEST_CASE("a shrink factor near 1: creases are estimated, the mesher settles, refusals name a shrink factor that fits",
-          "[estimate][mesher]") {
+          "[estimate][mesher][large]") {
   // At s = 0.999 the skin's necks bend with radii of curvature of about
   // 0.001 A. Before the crease term the estimate was 9,651 triangles against
   // 77,244 meshed, and the mesher chased one sample without triangles for 200

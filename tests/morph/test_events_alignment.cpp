@@ -100,7 +100,7 @@ TEST_CASE("cancelling events: a void sealed and filled in one step pairs, nothin
 }
 
 TEST_CASE("cancelling events of pept -> 3al1 are voids the alpha complex sees only inside the step",
-          "[morph][events]") {
+          "[morph][events][large]") {
   // Independent of the events' bookkeeping: the skin's topology counted
   // from B(t)'s alpha complex (skin_topology) before, between and after
   // every pair that no other event interleaves.

@@ -116,7 +116,7 @@ TEST_CASE("advance_to with the next frame announced makes the same frames, also 
   CHECK(mended_without_remesh > 0);  // the moving ahead overlapped edits or a patch
 }
 
-TEST_CASE("a void sealed and filled within one step is mended locally, with the skin's topology", "[morph][events]") {
+TEST_CASE("a void sealed and filled within one step is mended locally, with the skin's topology", "[morph][events][large]") {
   const auto source = test::centred_model(test::data_file("pept.pdb"), 1);
   const auto target = test::centred_model(test::data_file("3al1.pdb"), 1);
   test::BlendEvents blend(source, target);

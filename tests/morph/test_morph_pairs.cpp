@@ -184,15 +184,15 @@ Ball lone(double x, double y, double z, double skin_radius) {
 
 }  // namespace
 
-TEST_CASE("morph pept -> 3al1: every frame a quality mesh of B(t)", "[morph][pairs]") {
+TEST_CASE("morph pept -> 3al1: every frame a quality mesh of B(t)", "[morph][pairs][large]") {
   check_frames(molecule_balls("pept.pdb"), molecule_balls("3al1.pdb"), kSixFrames, Reference::static_mesher);
 }
 
-TEST_CASE("morph 3al1 -> 1ejg, two different molecules: every frame a quality mesh of B(t)", "[morph][pairs]") {
+TEST_CASE("morph 3al1 -> 1ejg, two different molecules: every frame a quality mesh of B(t)", "[morph][pairs][large]") {
   check_frames(molecule_balls("3al1.pdb"), molecule_balls("1ejg.pdb"), kSixFrames, Reference::static_mesher);
 }
 
-TEST_CASE("morph 2k39 model 1 -> 2, atoms barely moving: every frame a quality mesh of B(t)", "[morph][pairs]") {
+TEST_CASE("morph 2k39 model 1 -> 2, atoms barely moving: every frame a quality mesh of B(t)", "[morph][pairs][large]") {
   check_frames(molecule_balls("2k39_3models.pdb", 1), molecule_balls("2k39_3models.pdb", 2), kSixFrames,
                Reference::static_mesher);
 }
@@ -206,7 +206,7 @@ TEST_CASE("morph 2k39 model 1 -> 3 near t = 1: every frame on the skin of B(t) w
                {0.98, 0.99, 0.995, 0.999, 1.0}, Reference::static_mesher);
 }
 
-TEST_CASE("morph 1ubi -> 1hpv at t = 0.99: a nearly flat overlay cell keeps its frame on the skin", "[morph][pairs]") {
+TEST_CASE("morph 1ubi -> 1hpv at t = 0.99: a nearly flat overlay cell keeps its frame on the skin", "[morph][pairs][large]") {
   // A tetrahedron of the overlay (one source atom, four target atoms nearly
   // in a plane) had its size 1e-8 A^2 off at every t, from solving its
   // orthosphere through the normal equations, and its size curve carried
@@ -236,7 +236,7 @@ TEST_CASE("morph 1ubi -> 1hpv at t = 0.99: a nearly flat overlay cell keeps its 
   CHECK(*std::max_element(off.begin(), off.end()) <= 1e-8);
 }
 
-TEST_CASE("morph with atoms that do not move: a third of 2k39 moved, and a molecule onto itself", "[morph][pairs]") {
+TEST_CASE("morph with atoms that do not move: a third of 2k39 moved, and a molecule onto itself", "[morph][pairs][large]") {
   // Unmoved atoms make the two power diagrams share facets; the pairs of two
   // unmoved atoms have overlay cells of no volume and are left out of the
   // live pairs (kept, they stalled the refinement of every frame).
@@ -262,7 +262,7 @@ TEST_CASE("synthetic events: two balls merge, and the neck pinches off going bac
   }
 }
 
-TEST_CASE("synthetic events: a component is born and one dies", "[morph][events]") {
+TEST_CASE("synthetic events: a component is born and one dies", "[morph][events][large]") {
   const std::vector<Ball> one{lone(0, 0, 0, 1.5)};
   const std::vector<Ball> two{lone(0, 0, 0, 1.5), lone(6, 0, 0, 1.5)};
   std::vector<double> times;
@@ -281,7 +281,7 @@ TEST_CASE("synthetic events: a component is born and one dies", "[morph][events]
 // pept shrinking onto one atom: transport never removes a vertex, so without
 // thinning the frames keep pept's thousands of vertices on a skin a fresh
 // mesh covers with a hundred (issue: 893k triangles on a 36 A^2 sphere).
-TEST_CASE("morph pept -> one atom: every frame within 4 times a fresh mesh's vertex count", "[morph][pairs]") {
+TEST_CASE("morph pept -> one atom: every frame within 4 times a fresh mesh's vertex count", "[morph][pairs][large]") {
   const std::vector<Ball> source = molecule_balls("pept.pdb");
   const std::vector<Ball> target{source.front()};
   const std::vector<double> times{0.2, 0.4, 0.6, 0.8, 1.0};
@@ -335,7 +335,7 @@ TEST_CASE("synthetic events: a void closes", "[morph][events]") {
   check_events_cover_changes(prepare_morph(source, target, 0.0), records);
 }
 
-TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: few failing triangles are repaired locally", "[morph][pairs]") {
+TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: few failing triangles are repaired locally", "[morph][pairs][large]") {
   // A frame with a few failing triangles (at most PatchPolicy::max_failing_share of
   // them) and no topology event is mended in patches; the patch sees the
   // vertices of any sheet near it, not only those joined to it by the mesh,
@@ -365,7 +365,7 @@ TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: few failing triangles are r
   check_frames(source, target, {0.02, 0.05, 0.08, 0.11, 0.14, 0.18}, Reference::static_mesher);
 }
 
-TEST_CASE("morph repair policy: the patch's and the edits' thresholds reach the frames", "[morph][pairs]") {
+TEST_CASE("morph repair policy: the patch's and the edits' thresholds reach the frames", "[morph][pairs][large]") {
   // The same steps as above: with the default policy some frames are
   // mended by patches and some by edits; a patch allowed no attempt mends
   // none (those frames are remeshed whole), and with edits off none is
@@ -401,7 +401,7 @@ TEST_CASE("morph repair policy: the patch's and the edits' thresholds reach the 
   CHECK(run(RepairPolicy{}).edits > 0);
 }
 
-TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: failing triangles are mended by edits of the mesh", "[morph][pairs]") {
+TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: failing triangles are mended by edits of the mesh", "[morph][pairs][large]") {
   // A frame whose failing triangles are mended by splits, flips and
   // contractions alone (no patch, no remesh) is checked as every frame is:
   // the morph oracle, the angle bound, closed, oriented and manifold with no
@@ -418,7 +418,7 @@ TEST_CASE("morph 2k39 model 1 -> 3 in steps of 0.01: failing triangles are mende
   CHECK(mended >= 5);
 }
 
-TEST_CASE("critical events account for every change of the skin's Euler characteristic", "[morph][events]") {
+TEST_CASE("critical events account for every change of the skin's Euler characteristic", "[morph][events][large]") {
   // Between two frames the Euler characteristic of the static mesher's mesh
   // of B(t) (built from scratch, blind to the events) changes by the sum of
   // the critical events' changes in between: Morse theory on the skin's
@@ -461,7 +461,7 @@ TEST_CASE("critical events account for every change of the skin's Euler characte
   }
 }
 
-TEST_CASE("morph 2k39 model 1 -> 3: a neck that opens or pinches between frames is remeshed locally", "[morph][events]") {
+TEST_CASE("morph 2k39 model 1 -> 3: a neck that opens or pinches between frames is remeshed locally", "[morph][events][large]") {
   // A critical event of dimension 1 or 2 between two frames is handled by
   // the local repair, its patch reaching around the event's apex, and the
   // patch is taken only when the Euler characteristic changes as the events

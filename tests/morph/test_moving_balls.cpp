@@ -131,7 +131,7 @@ TEST_CASE("skin topology from the alpha complex: shapes of known topology", "[mo
   }
 }
 
-TEST_CASE("skin topology from the alpha complex equals the mesher's on every molecule of data/", "[moving][topology]") {
+TEST_CASE("skin topology from the alpha complex equals the mesher's on every molecule of data/", "[moving][topology][large]") {
   for (const char* name : {"pept.pdb", "1ubi.pdb", "3al1.pdb", "2k39_3models.pdb", "1ejg.pdb"}) {
     INFO(name);
     const std::vector<Ball> balls = molecule_balls(name);
@@ -202,7 +202,7 @@ TEST_CASE("moving balls: the same balls again give the same frame", "[moving]") 
   }
 }
 
-TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every frame checked", "[moving]") {
+TEST_CASE("moving balls: a hinge motion of ubiquitin's C-terminal strand, every frame checked", "[moving][large]") {
   const UbiquitinTail tail = ubiquitin_tail(66);
   const std::vector<Ball>& start = tail.start;
   const std::vector<char>& strand = tail.moving;
@@ -316,7 +316,7 @@ TEST_CASE("a matched motion leaves the atoms that do not move where they are, bi
   }
 }
 
-TEST_CASE("moving balls: a patch's new triangles pass the frame judge next to necks about to pinch", "[moving]") {
+TEST_CASE("moving balls: a patch's new triangles pass the frame judge next to necks about to pinch", "[moving][large]") {
   // Half of ubiquitin's atoms (from index 300 on) turned 3 degrees a frame
   // about an axis through atom 300, in steps of up to 0.5 A: steps that
   // open and pinch necks where the halves meet. At frame 5 a patch's
@@ -344,7 +344,7 @@ TEST_CASE("moving balls: a patch's new triangles pass the frame judge next to ne
 }
 
 TEST_CASE("moving balls: necks that open in a step are mended by the local patch with their topology and ids",
-          "[moving]") {
+          "[moving][large]") {
   // 3mht's chain A with residues 187-304 turning 0.2 degrees a frame about
   // the axis through the CA atoms of residues 186 and 305, as the frames of
   // a PDB trajectory hold them (coordinates to 1e-3 A). At frame 8 necks
@@ -445,7 +445,7 @@ TEST_CASE("moving balls: ubiquitin's NMR models 1 -> 2 -> 3 as one motion, ids k
   }
 }
 
-TEST_CASE("moving balls: ubiquitin's atoms in thermal motion, voids opening and closing, every frame valid", "[moving]") {
+TEST_CASE("moving balls: ubiquitin's atoms in thermal motion, voids opening and closing, every frame valid", "[moving][large]") {
   // Each frame puts every atom at its rest place plus its own offset, up to
   // 0.15 A along each axis (seeded): an MD-like ensemble, whose small voids
   // and tunnels open and close from one frame to the next. Every frame is

@@ -199,7 +199,7 @@ TEST_CASE("local repair: after an attempt with faults only the pieces that had t
   CHECK(kept > 0);
 }
 
-TEST_CASE("local repair: a new point whose star does not close grows the patch over the context near it", "[morph]") {
+TEST_CASE("local repair: a new point whose star does not close grows the patch over the context near it", "[morph][large]") {
   // The last 42 atoms turned by 25 degrees: a new point near the patch's
   // rim misses triangles whose third corner is context, and growing around
   // the star's own corners never reaches that context.

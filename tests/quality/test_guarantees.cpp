@@ -12,7 +12,7 @@
 
 using namespace skinmesh;
 
-TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where broken", "[quality][guarantees]") {
+TEST_CASE("check_guarantees: all hold on the mesher's mesh, each fails where broken", "[quality][guarantees][large]") {
   const auto balls = balls_from_molecule(read_molecule(test::data_file("pept.pdb")), 0.5);
   const SkinMeshResult r = mesh_skin(build_skin_complex(balls, {0.5}));
   REQUIRE(r.status == MeshingStatus::ok);

@@ -111,7 +111,7 @@ TetImprovement improve_and_check(TetMesh& mesh) {
 
 }  // namespace
 
-TEST_CASE("interior volume meshes: bounds, exact volume, the surface as boundary", "[volume]") {
+TEST_CASE("interior volume meshes: bounds, exact volume, the surface as boundary", "[volume][large]") {
   check_interior(test::data_file("pept.pdb"));
   check_interior(test::data_file("1ubi.pdb"));
   check_interior(test::data_file("1ejg.pdb"));
