@@ -22,6 +22,7 @@
 //
 //   bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command]
 //                [--first-size-margin X]   (c only: MovingOptions::first_size_margin, default the engine's)
+//                [--retry-around-faults on|off]   (c only: PatchPolicy::retry_around_faults)
 #include "forked.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/stopwatch.hpp"
@@ -399,10 +400,12 @@ int main(int argc, char** argv) {
     else if (a == "--sample" && i + 1 < argc) sample = std::atoi(argv[++i]);
     else if (a == "--timeout" && i + 1 < argc) timeout = std::atoi(argv[++i]);
     else if (a == "--first-size-margin" && i + 1 < argc) engine_options.first_size_margin = std::atof(argv[++i]);
+    else if (a == "--retry-around-faults" && i + 1 < argc)
+      engine_options.repair.patch.retry_around_faults = std::string(argv[++i]) == "on";
     else {
       std::fprintf(stderr,
                    "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command] "
-                   "[--first-size-margin X]\n");
+                   "[--first-size-margin X] [--retry-around-faults on|off]\n");
       return 2;
     }
   }

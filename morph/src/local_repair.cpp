@@ -442,6 +442,8 @@ struct Attempt {
   std::vector<SkinSample> added;
   std::vector<Triangle> fresh;  // the patch's triangles, replacing the region's
   std::vector<int> faults;
+  std::vector<int> open_new;    // new points (numbered as in `fresh`) whose star does not close
+  std::vector<char> bad;        // per triangle of `fresh`: fails the frame criteria
   bool meshed = false;          // the refinement ended ok (faults may remain)
   bool stopped = false;         // the refinement stopped (stalled, over budget)
   bool too_large = false;       // not tried: with its context, nearly the whole frame
@@ -533,11 +535,11 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   kept_near.erase(std::unique(kept_near.begin(), kept_near.end()), kept_near.end());
   a.fresh = patch_triangles(mesh, patch, index, kept_near);
   a.added = std::move(patch.added);
-  std::vector<int> open_new;
-  a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop, open_new);
-  add_near_open_stars(mesh, role, a.added, a.fresh, open_new, options.policy.open_star_reach, a.faults);
+  a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop, a.open_new);
+  add_near_open_stars(mesh, role, a.added, a.fresh, a.open_new, options.policy.open_star_reach, a.faults);
   const size_t seam = a.faults.size();
-  const std::vector<char> bad = failing_fresh(complex, mesh, a.added, a.fresh, accept);
+  a.bad = failing_fresh(complex, mesh, a.added, a.fresh, accept);
+  const std::vector<char>& bad = a.bad;
   for (size_t f = 0; f < a.fresh.size(); ++f)
     if (bad[f])
       for (int v : a.fresh[f])
@@ -600,12 +602,42 @@ Holding holding_pieces(const SurfaceMesh& mesh, const std::vector<char>& region,
   return h;
 }
 
+// The whole of attempt `a` as if it held: every region triangle replaced
+// by every patch triangle (Retry::around_faults).
+Holding everything(const SurfaceMesh& mesh, const std::vector<char>& region, const Attempt& a) {
+  Holding h;
+  h.region = region;
+  h.fresh.assign(a.fresh.size(), 1);
+  h.pieces = 1;
+  std::vector<char> own(mesh.vertices.size(), 0);
+  for (size_t f = 0; f < region.size(); ++f)
+    if (region[f])
+      for (int v : mesh.triangles[f]) own[static_cast<size_t>(v)] = 1;
+  h.own = std::count(own.begin(), own.end(), 1);
+  return h;
+}
+
+// The vertices marked in `touched` whose triangles are there but do not
+// make one disk.
+std::vector<int> open_stars(const SurfaceMesh& mesh, const VertexStars& stars, const std::vector<char>& touched) {
+  std::vector<int> open;
+  std::vector<Triangle> around;
+  for (int v = 0; v < static_cast<int>(touched.size()); ++v) {
+    if (!touched[static_cast<size_t>(v)] || stars.empty(v)) continue;
+    around.clear();
+    stars.each(v, [&](int f) { around.push_back(mesh.triangles[static_cast<size_t>(f)]); });
+    if (!star_is_disk(v, around)) open.push_back(v);
+  }
+  return open;
+}
+
 // The pieces of `a` that hold put into `mesh` (new points appended, in the
 // order the patch made them); `region` follows the mesh's triangles (the
 // region's triangles not replaced, none of the new ones). Returns the
-// points added.
+// points added; `placed` gets each new point's vertex in the mesh (-1: not
+// put in).
 long put_in(const SkinComplex& complex, SurfaceMesh& mesh, std::vector<char>& region, const Attempt& a,
-            const Holding& h) {
+            const Holding& h, std::vector<int>& placed) {
   const size_t n = mesh.vertices.size();
   std::vector<Triangle> triangles;
   std::vector<char> still;
@@ -615,7 +647,7 @@ long put_in(const SkinComplex& complex, SurfaceMesh& mesh, std::vector<char>& re
       triangles.push_back(mesh.triangles[f]);
       still.push_back(region[f]);
     }
-  std::vector<int> placed(a.added.size(), -1);
+  placed.assign(a.added.size(), -1);
   for (size_t f = 0; f < a.fresh.size(); ++f) {
     if (!h.fresh[f]) continue;
     Triangle t = a.fresh[f];
@@ -717,8 +749,12 @@ bool topology_as_expected(const SurfaceMesh& before, const SurfaceMesh& after, c
 }
 
 // How an attempt after the first meshes the patch: only the pieces that did
-// not hold (the others go into the mesh at once), or the whole region again.
-enum class Retry { pieces, whole };
+// not hold (the others go into the mesh at once), the whole region again,
+// or only around the first attempt's faults (every triangle of it goes
+// into the mesh at once, and the next region is the triangles, old or
+// new, around the vertices where the seam or a new triangle failed; then
+// on in pieces).
+enum class Retry { pieces, whole, around_faults };
 
 // How the attempts on a patch in pieces ended, when they failed.
 struct PiecesFailure {
@@ -726,6 +762,37 @@ struct PiecesFailure {
   bool ran_away = false;     // the last attempt's refinement stopped (stalled, over budget)
   bool too_large = false;    // the patch with its context took nearly the whole frame
 };
+
+// Marks the corners of the region's triangles, whose stars a put-in of the
+// whole attempt changes.
+void mark_touched(const SurfaceMesh& mesh, const std::vector<char>& region, std::vector<char>& touched) {
+  touched.resize(mesh.vertices.size(), 0);
+  for (size_t f = 0; f < region.size(); ++f)
+    if (region[f])
+      for (int v : mesh.triangles[f]) touched[static_cast<size_t>(v)] = 1;
+}
+
+// After the whole of attempt `a` went into `mesh` (its new points from
+// `before` on, as `placed` says), the faults to mesh around next: the
+// attempt's own (old vertices keep their numbers), its new points whose
+// star did not close, the new corners of its failing triangles, and every
+// touched vertex whose star is not one disk now. The new points join
+// `touched`.
+void faults_after_all_in(const SurfaceMesh& mesh, const VertexStars& stars, const Attempt& a, size_t before,
+                         const std::vector<int>& placed, std::vector<char>& touched, std::vector<int>& faults) {
+  auto in_mesh = [&](int v) {
+    return static_cast<size_t>(v) < before ? v : placed[static_cast<size_t>(v) - before];
+  };
+  for (int v : a.open_new) faults.push_back(in_mesh(v));
+  for (size_t f = 0; f < a.fresh.size(); ++f)
+    if (a.bad[f])
+      for (int v : a.fresh[f]) faults.push_back(in_mesh(v));
+  touched.resize(mesh.vertices.size(), 0);
+  for (int v : placed)
+    if (v >= 0) touched[static_cast<size_t>(v)] = 1;
+  for (int v : open_stars(mesh, stars, touched)) faults.push_back(v);
+  faults.erase(std::remove(faults.begin(), faults.end(), -1), faults.end());
+}
 
 // The attempts on one patch.
 RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
@@ -745,6 +812,7 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
   SoFar so_far;
   so_far.local_scale = local_scale;
   bool widened = false;
+  std::vector<char> touched;  // vertices whose star an all-in put-in changed (Retry::around_faults)
   for (int attempt = 0; attempt < options.policy.attempts; ++attempt) {
     ++out.attempts;
     out.attempted_triangles += std::count(region.begin(), region.end(), 1);
@@ -772,11 +840,16 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
     }
     // The pieces that hold go in now (all of them when there are no
     // faults); the next attempt remeshes the others, grown around their faults.
-    const Holding holding = holding_pieces(mesh, region, a);
-    const bool put = a.faults.empty() || (retry == Retry::pieces && holding.faulty < holding.pieces);
+    const bool all_in = retry == Retry::around_faults && attempt == 0 && !a.faults.empty();
+    const Holding holding = all_in ? everything(mesh, region, a) : holding_pieces(mesh, region, a);
+    const bool put = a.faults.empty() || all_in || (retry != Retry::whole && holding.faulty < holding.pieces);
+    std::vector<int> faults = a.faults;  // in the mesh's numbering after the put-in
     if (put) {
       out.counts.patch_triangles += std::count(holding.region.begin(), holding.region.end(), 1);
-      const long inserted = put_in(complex, mesh, region, a, holding);
+      const size_t before = mesh.vertices.size();
+      if (all_in) mark_touched(mesh, region, touched);
+      std::vector<int> placed;
+      const long inserted = put_in(complex, mesh, region, a, holding, placed);
       out.counts.insertions += inserted;
       so_far.own += holding.own;
       so_far.inserted += inserted;
@@ -784,8 +857,14 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
         failure.put_in = true;
         stars = std::make_unique<VertexStars>(mesh);
       }
+      if (all_in) faults_after_all_in(mesh, *stars, a, before, placed, touched, faults);
     }
     if (a.faults.empty()) {
+      if (std::find(touched.begin(), touched.end(), 1) != touched.end() &&
+          !open_stars(mesh, VertexStars(mesh), touched).empty()) {
+        out.failed_because = "a vertex the patch's attempts touched has triangles that are not one disk";
+        return out;
+      }
       if (!topology_as_expected(given, mesh, options)) {
         out.failed_because = "the patched mesh's Euler characteristic or components are not what the topology "
                              "changes say";
@@ -808,7 +887,7 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
       return out;
     }
     std::vector<char> more(region.size(), 0);
-    for (int v : a.faults) stars->each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });
+    for (int v : faults) stars->each(v, [&](int f) { more[static_cast<size_t>(f)] = 1; });
     more = grow_region(mesh, *stars, std::move(more), 1);
     bool grew = false;
     for (size_t f = 0; f < region.size(); ++f)
@@ -818,6 +897,8 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
   }
   return out;
 }
+
+Retry piecewise(const PatchPolicy& policy) { return policy.retry_around_faults ? Retry::around_faults : Retry::pieces; }
 
 // Retrying only the pieces that did not hold is cheaper, but a piece alone
 // can fail where the whole region succeeds: its refinement runs away with
@@ -830,7 +911,8 @@ RepairResult whole_context_patch(const SkinComplex& complex, const SurfaceMesh& 
   PiecesFailure failure;
   if (!options.policy.retry_in_pieces)
     return patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, 0, failure);
-  RepairResult out = patch_attempts(complex, given, failing, repair, accept, options, Retry::pieces, 0, failure);
+  RepairResult out = patch_attempts(complex, given, failing, repair, accept, options, piecewise(options.policy), 0,
+                                    failure);
   if (out.ok || !failure.put_in || !failure.ran_away) return out;
   RepairResult whole = patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, 0, failure);
   whole.attempts += out.attempts;
@@ -853,7 +935,7 @@ RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given
                            const LocalRepairOptions& options) {
   if (!options.policy.local_context_first) return whole_context_patch(complex, given, failing, repair, accept, options);
   PiecesFailure failure;
-  const Retry retry = options.policy.retry_in_pieces ? Retry::pieces : Retry::whole;
+  const Retry retry = options.policy.retry_in_pieces ? piecewise(options.policy) : Retry::whole;
   RepairResult local = patch_attempts(complex, given, failing, repair, accept, options, retry, 1.0, failure);
   if (local.ok || failure.too_large) return local;
   RepairResult whole = whole_context_patch(complex, given, failing, repair, accept, options);

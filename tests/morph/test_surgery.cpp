@@ -179,6 +179,7 @@ TEST_CASE("local repair: after an attempt with faults only the pieces that had t
   // The strand's last 32 atoms turned by 2 degrees, patched with and
   // without retrying in pieces.
   TurnedStrand f = turned_strand(570, 2);
+  f.options.policy.retry_around_faults = false;
   const detail::RepairResult whole = patched_with(f, &PatchPolicy::retry_in_pieces, false);
   const detail::RepairResult pieces = patched_with(f, &PatchPolicy::retry_in_pieces, true);
   REQUIRE(whole.ok);
@@ -197,6 +198,31 @@ TEST_CASE("local repair: after an attempt with faults only the pieces that had t
       CHECK(pieces.mesh.vertices[v] == f.edited.mesh.vertices[static_cast<size_t>(pieces.origin[v])]);
     }
   CHECK(kept > 0);
+}
+
+TEST_CASE("local repair: after an attempt with faults only the triangles around its faults are meshed again",
+          "[morph]") {
+  // The strand's last 62 atoms turned by 3 degrees (a first region of
+  // thousands of triangles), retried in pieces and around the faults.
+  // Around the faults, every triangle of the first attempt goes in and the
+  // second meshes the fault neighbourhoods only: fewer triangles in all
+  // than meshing each faulty piece again.
+  TurnedStrand f = turned_strand(540, 3);
+  const detail::RepairResult pieces = patched_with(f, &PatchPolicy::retry_around_faults, false);
+  const detail::RepairResult around = patched_with(f, &PatchPolicy::retry_around_faults, true);
+  REQUIRE(pieces.ok);
+  REQUIRE(pieces.attempts >= 2);
+  REQUIRE(around.ok);
+  REQUIRE(around.attempts >= 2);
+  INFO("triangles meshed: around the faults " << around.attempted_triangles << " in " << around.attempts
+                                               << " attempts, in pieces " << pieces.attempted_triangles << " in "
+                                               << pieces.attempts);
+  CHECK(around.attempted_triangles < pieces.attempted_triangles);
+  check_patched(f, around);
+  REQUIRE(around.origin.size() == around.mesh.vertices.size());
+  for (size_t v = 0; v < around.origin.size(); ++v)
+    if (around.origin[v] >= 0)
+      CHECK(around.mesh.vertices[v] == f.edited.mesh.vertices[static_cast<size_t>(around.origin[v])]);
 }
 
 TEST_CASE("local repair: a new point whose star does not close grows the patch over the context near it", "[morph][large]") {

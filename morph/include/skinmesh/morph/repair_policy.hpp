@@ -60,6 +60,15 @@ struct PatchPolicy {
   // tried once more with the whole region. false: every attempt remeshes
   // the whole region.
   bool retry_in_pieces = true;
+  // Finer still (with retry_in_pieces): after a first attempt that left
+  // faults, all its triangles go into the mesh, and the next attempt
+  // remeshes only the triangles (old or new) around the vertices where the
+  // seam or a new triangle failed; later attempts go on in pieces. The
+  // frame is taken only when every vertex the first attempt touched ends
+  // with one disk of triangles. The first attempt is most of a patch's
+  // work, and nearly all of it holds. Moving atoms turn it on
+  // (moving_balls.hpp); the blend's frames were not measured with it.
+  bool retry_around_faults = false;
   // A patch whose refinement stalls (it needs more than twice its own
   // points: most often it meshes the far side of a thin gap that its
   // context did not reach) is tried once more over the same region with
