@@ -23,6 +23,7 @@
 //   bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command]
 //                [--first-size-margin X]   (c only: MovingOptions::first_size_margin, default the engine's)
 //                [--retry-around-faults on|off]   (c only: PatchPolicy::retry_around_faults)
+//                [--frame-log FILE]   (c only: each later frame's FrameStats, a JSON line per frame)
 #include "forked.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/stopwatch.hpp"
@@ -210,8 +211,25 @@ struct Column {
 
 double s_of(int k, int frames) { return static_cast<double>(k) / (frames - 1); }
 
-Column run_engine(const Motion& motion, int frames, const MovingOptions& options) {
+// A frame's stats as one JSON line: where its time went and what its repair did.
+void log_frame(std::FILE* log, const std::string& motion, int k, const FrameStats& s) {
+  const nlohmann::json j = {{"motion", motion}, {"frame", k}, {"seconds", s.seconds},
+                            {"complex", s.seconds_complex}, {"transport", s.seconds_transport},
+                            {"relax", s.seconds_relax}, {"judge", s.seconds_judge}, {"repair", s.seconds_repair},
+                            {"steps", s.steps}, {"triangles", s.triangles}, {"moved", s.moved},
+                            {"relocated", s.relocated}, {"settled", s.settled}, {"bad_triangles", s.bad_triangles},
+                            {"events", s.events}, {"split", s.split}, {"flipped", s.flipped},
+                            {"contracted", s.contracted}, {"patch_triangles", s.patch_triangles},
+                            {"inserted", s.inserted}, {"removed", s.removed}, {"remeshed", s.remeshed},
+                            {"full_rebuild", s.full_rebuild}, {"because", s.remeshed_because}};
+  std::fprintf(log, "%s\n", j.dump().c_str());
+  std::fflush(log);
+}
+
+Column run_engine(const Motion& motion, int frames, const MovingOptions& options, const std::string& frame_log) {
   Column c;
+  std::FILE* log = frame_log.empty() ? nullptr : std::fopen(frame_log.c_str(), "a");
+  if (!frame_log.empty() && log == nullptr) throw std::runtime_error("cannot open " + frame_log);
   std::vector<Ball> before = motion.at(0);
   const auto start = Clock::now();
   MovingBalls moving(before, options);
@@ -235,9 +253,11 @@ Column run_engine(const Motion& motion, int frames, const MovingOptions& options
     c.min_ids_kept = std::min(c.min_ids_kept, s.ids_kept);
     c.mean_ids_kept += s.ids_kept / (frames - 1);
     c.max_kept_move = std::max(c.max_kept_move, s.max_kept_move);
+    if (log != nullptr) log_frame(log, motion.name, k, s);
     c.grade(f.mesh, balls);
     before = balls;
   }
+  if (log != nullptr) std::fclose(log);
   return c;
 }
 
@@ -390,6 +410,7 @@ void print_ratios(const std::vector<Row>& rows) {
 int main(int argc, char** argv) {
   int frames = 101, sample = 5, timeout = 3600;
   std::string only;  // run the motions whose name holds this text
+  std::string frame_log;
   bool skip_command = false;
   MovingOptions engine_options;
   for (int i = 1; i < argc; ++i) {
@@ -400,12 +421,13 @@ int main(int argc, char** argv) {
     else if (a == "--sample" && i + 1 < argc) sample = std::atoi(argv[++i]);
     else if (a == "--timeout" && i + 1 < argc) timeout = std::atoi(argv[++i]);
     else if (a == "--first-size-margin" && i + 1 < argc) engine_options.first_size_margin = std::atof(argv[++i]);
+    else if (a == "--frame-log" && i + 1 < argc) frame_log = argv[++i];
     else if (a == "--retry-around-faults" && i + 1 < argc)
       engine_options.repair.patch.retry_around_faults = std::string(argv[++i]) == "on";
     else {
       std::fprintf(stderr,
                    "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command] "
-                   "[--first-size-margin X] [--retry-around-faults on|off]\n");
+                   "[--first-size-margin X] [--retry-around-faults on|off] [--frame-log FILE]\n");
       return 2;
     }
   }
@@ -421,7 +443,7 @@ int main(int argc, char** argv) {
     print_json(b);
     rows.push_back(b);
     Row c{motion.name, "c moving balls", motion.atoms,
-          bench::run_forked<Column>(timeout, [&] { return run_engine(motion, frames, engine_options); })};
+          bench::run_forked<Column>(timeout, [&] { return run_engine(motion, frames, engine_options, frame_log); })};
     print_json(c);
     rows.push_back(c);
     if (skip_command) continue;
