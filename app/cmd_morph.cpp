@@ -11,6 +11,7 @@
 #include "output_file.hpp"
 #include "quality_report.hpp"
 
+#include "skinmesh/core/allocator.hpp"
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/interpolation.hpp"
 #include "skinmesh/core/number_text.hpp"
@@ -587,6 +588,7 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
 // A frame the mesher refuses is answered as `mesh` answers: an empty skin
 // is bad input (exit 2), a budget or another refusal a job refused (exit 3).
 ExitCode run_morph(const MorphCommandOptions& o, const GlobalOptions& global) {
+  keep_large_blocks_for_reuse();  // frame after frame, the same large lists
   try {
     return run_morph_frames(o, global);
   } catch (const MeshingFailed& e) {

@@ -12,6 +12,7 @@
 #include "output_file.hpp"
 #include "quality_report.hpp"
 
+#include "skinmesh/core/allocator.hpp"
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/morph/alignment.hpp"
@@ -216,6 +217,7 @@ ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& 
 
 // A frame the mesher refuses: as `mesh` answers it (refused_meshing).
 ExitCode run_trajectory(const TrajectoryOptions& o, const GlobalOptions& global) {
+  keep_large_blocks_for_reuse();  // frame after frame, the same large lists
   try {
     return run_trajectory_frames(o, global);
   } catch (const MeshingFailed& e) {

@@ -88,6 +88,7 @@ std::vector<double> frame_times(int n) {
 }
 
 Column run_morph(const Pair& p, int frames, bool local_repair) {
+  keep_large_blocks_for_reuse();  // as `skinmesh morph` does
   const MorphOracle oracle(p.source, p.target, kShrink);
   const std::vector<double> ts = frame_times(frames);
   Column c;

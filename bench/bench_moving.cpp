@@ -25,6 +25,7 @@
 //                [--retry-around-faults on|off]   (c only: PatchPolicy::retry_around_faults)
 //                [--frame-log FILE]   (c only: each later frame's FrameStats, a JSON line per frame)
 #include "forked.hpp"
+#include "skinmesh/core/allocator.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
@@ -227,6 +228,7 @@ void log_frame(std::FILE* log, const std::string& motion, int k, const FrameStat
 }
 
 Column run_engine(const Motion& motion, int frames, const MovingOptions& options, const std::string& frame_log) {
+  keep_large_blocks_for_reuse();  // as `skinmesh trajectory` does
   Column c;
   std::FILE* log = frame_log.empty() ? nullptr : std::fopen(frame_log.c_str(), "a");
   if (!frame_log.empty() && log == nullptr) throw std::runtime_error("cannot open " + frame_log);

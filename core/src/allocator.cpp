@@ -15,4 +15,13 @@ void return_large_blocks_to_system() {
 #endif
 }
 
+void keep_large_blocks_for_reuse() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+  // The heap's top is given back only past this much free memory (the
+  // default, 128 KiB, gave back and faulted in again a frame's copies).
+  mallopt(M_TRIM_THRESHOLD, 256 * 1024 * 1024);
+#endif
+}
+
 }  // namespace skinmesh
