@@ -319,6 +319,19 @@ struct SkinComplexBuilder {
     }
   }
 
+  // Every cell's geometry from the balls, each cell on its own, on every
+  // core: a morph moves the complex every frame, and serially this was a
+  // tenth of a frame. Every field of the geometry is written, so a cell's
+  // earlier frame leaves nothing behind.
+  static void compute_geometry(SkinComplex& sc) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, sc.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t c = r.begin(); c != r.end(); ++c) {
+        sc.cells_[c].degenerate = false;
+        compute_cell_geometry(sc.cells_[c], sc.balls_);
+      }
+    });
+  }
+
   // A uniform grid over the centres of the non-hidden balls: walks start from
   // the vertex cell of the ball of least power in the nearest buckets.
   static void build_start_grid(SkinComplex& sc) {
@@ -364,15 +377,7 @@ struct SkinComplexBuilder {
         contract_error("with_balls: known cells must be in range and ascending");
     if (out.combinatorics_ != from.combinatorics_ || out.cells_.size() != from.cells_.size()) out = from;
     out.balls_ = std::move(balls);
-    // Each cell on its own, on every core: a morph moves the complex every
-    // frame, and serially this was a tenth of a frame. Every field of the
-    // geometry is written, so a cell's earlier frame leaves nothing behind.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, out.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t c = r.begin(); c != r.end(); ++c) {
-        out.cells_[c].degenerate = false;
-        compute_cell_geometry(out.cells_[c], out.balls_);
-      }
-    });
+    compute_geometry(out);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, known.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t k = r.begin(); k != r.end(); ++k) {
         MixedCell& cell = out.cells_[static_cast<size_t>(known[k].cell)];
@@ -402,10 +407,7 @@ struct SkinComplexBuilder {
     sc.dimension_ = rt.dimension();
     add_simplices(rt, sc);
     link_faces(sc);
-    // Each cell on its own, on every core (as `moved` does).
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, sc.cells_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t c = r.begin(); c != r.end(); ++c) compute_cell_geometry(sc.cells_[c], sc.balls_);
-    });
+    compute_geometry(sc);
     add_constraints_beyond_flat_cofaces(sc.cells_, sc.faces_, sc.face_offset_, sc.cofaces_, sc.coface_offset_);
     build_start_grid(sc);
     return sc;
