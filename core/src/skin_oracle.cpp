@@ -141,14 +141,23 @@ int least_phi(const Problem& p, const std::vector<int>& candidates) {
   return start;
 }
 
-// Active-set solve restricted to `candidates`. Returns the support and weights.
-Solution solve_on(const Problem& p, const std::vector<int>& candidates) {
+// Active-set solve restricted to `candidates`. Returns the support and
+// weights. `warm`: the working set starts as all the candidates, at equal
+// weights (a mesh vertex's mixed-cell balls, which are the minimiser's
+// support at a point inside the cell: one step there instead of a ball
+// added per step); else as the candidate of least objective alone.
+Solution solve_on(const Problem& p, const std::vector<int>& candidates, bool warm = false) {
   const double s = p.s;
   std::vector<int> S{least_phi(p, candidates)};
   std::vector<double> l{1.0};
   // After a full step the weights sit at the minimiser on S: the next solve's
   // step is round-off, so go straight to the multipliers.
   bool at_subproblem_minimum = true;
+  if (warm && candidates.size() > 1) {
+    S = candidates;
+    l.assign(S.size(), 1.0 / static_cast<double>(S.size()));
+    at_subproblem_minimum = false;
+  }
   for (int iteration = 0; iteration < 200; ++iteration) {
     const int k = static_cast<int>(S.size());
     Eigen::Vector3d y = Eigen::Vector3d::Zero();
@@ -340,12 +349,13 @@ OracleResult SkinOracle::evaluate(const Eigen::Vector3d& x, const std::array<int
     if (ball >= 0) candidates.push_back(ball);
   }
   if (candidates.empty()) return evaluate(x);
-  return solve_from(x, std::move(candidates));
+  const bool warm = candidates.size() <= 4;
+  return solve_from(x, std::move(candidates), warm);
 }
 
 // The solve from `candidates` (not empty for a finite x), which grow by
 // every ball the KKT check finds violating until none does.
-OracleResult SkinOracle::solve_from(const Eigen::Vector3d& x, std::vector<int> candidates) const {
+OracleResult SkinOracle::solve_from(const Eigen::Vector3d& x, std::vector<int> candidates, bool warm) const {
   if (!x.allFinite()) {  // no answer to certify (the maxima below would pass NaN over)
     OracleResult none;
     none.value = NAN;
@@ -355,7 +365,7 @@ OracleResult SkinOracle::solve_from(const Eigen::Vector3d& x, std::vector<int> c
   const Problem p{balls_, shrink_, x};
   OracleResult out;
   for (int round = 0; round < 50; ++round) {
-    const Solution sol = solve_on(p, candidates);
+    const Solution sol = solve_on(p, candidates, warm && round == 0);
     const Stationary st = stationary(p, sol);
     take_solution(out, st, sol, [](int ball) { return ball; });
     // The KKT check against every ball: those beyond the certification

@@ -54,7 +54,8 @@ class SkinOracle {
   // Balls far from x are certified by a bound instead of one by one
   // (evaluate); the grid finds the near ones.
   std::shared_ptr<const BallGrid> grid_;
-  OracleResult solve_from(const Eigen::Vector3d& x, std::vector<int> candidates) const;
+  // warm: the first solve starts from all the candidates (a start's balls).
+  OracleResult solve_from(const Eigen::Vector3d& x, std::vector<int> candidates, bool warm = false) const;
   friend class MorphOracle;  // certifies each side's balls with its grid the same way
 };
 
