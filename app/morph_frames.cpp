@@ -282,6 +282,7 @@ FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self
 json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
   json j = frame_json(s, c, file);
   j["steps"] = s.steps;
+  j["steps_built_ahead"] = s.built_ahead;
   j["reidentified"] = s.reidentified;
   j["settled"] = s.settled;
   j["ids_kept"] = s.ids_kept;
@@ -345,7 +346,8 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
     return true;
   };
   for (size_t k = 0; k < run.times.size(); ++k) {
-    if (k > 0) moving.advance_to(run.balls_of(k), run.times[k]);
+    if (k > 0)  // told the frame after, whose first step's complex is built beside this frame's repair
+      moving.advance_to(run.balls_of(k), run.times[k], k + 1 < run.times.size() ? run.balls_of(k + 1) : std::vector<Ball>{});
     MadeFrame made = snapshot(moving, k);
     if (k > 0 && !finish()) return result;
     pending = std::move(made);

@@ -241,7 +241,9 @@ Column run_engine(const Motion& motion, int frames, const MovingOptions& options
   for (int k = 1; k < frames; ++k) {
     const std::vector<Ball> balls = motion.at(s_of(k, frames));
     for (size_t i = 0; i < balls.size(); ++i) c.max_atom_move = std::max(c.max_atom_move, (balls[i].center - before[i].center).norm());
-    const MorphFrame& f = moving.advance_to(balls, s_of(k, frames));
+    // Told the frame after, as `skinmesh trajectory` tells it.
+    const MorphFrame& f =
+        moving.advance_to(balls, s_of(k, frames), k + 1 < frames ? motion.at(s_of(k + 1, frames)) : std::vector<Ball>{});
     const FrameStats& s = f.stats;
     c.seconds += s.seconds;
     c.seconds_complex += s.seconds_complex;

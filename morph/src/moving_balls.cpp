@@ -20,6 +20,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 namespace skinmesh {
@@ -503,11 +504,30 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
   return out;
 }
 
+// The first internal step advance_to takes from `from` towards `to`: at
+// most max_step for any ball (as advance_to divides the move).
+std::vector<Ball> first_step(const std::vector<Ball>& from, const std::vector<Ball>& to, double max_step) {
+  double farthest = 0;
+  for (size_t i = 0; i < from.size(); ++i) farthest = std::max(farthest, ball_move(from[i], to[i]));
+  const long steps = std::max(1L, static_cast<long>(std::ceil(farthest / max_step)));
+  return steps == 1 ? to : balls_between(from, to, 1.0 / static_cast<double>(steps));
+}
+
+bool same_balls(const std::vector<Ball>& a, const std::vector<Ball>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const Ball& x, const Ball& y) { return x.center == y.center && x.weight == y.weight; });
+}
+
 // The engine's state and its steps: MovingBalls' public calls forward here.
 struct MovingBalls::Impl {
   Impl(std::vector<Ball> balls, const MovingOptions& options, double t);
-  const MorphFrame& advance_to(std::vector<Ball> balls, double t);
-  void step(std::vector<Ball> balls);
+  ~Impl() { forget_ahead(); }
+  const MorphFrame& advance_to(std::vector<Ball> balls, double t, const std::vector<Ball>& next);
+  void step(std::vector<Ball> balls, const std::vector<Ball>* after);
+  void build_ahead();
+  bool take_ahead(const std::vector<Ball>& balls, std::optional<SkinComplex>& complex, SkinTopology& topology);
+  void finish_ahead();
+  void forget_ahead();
   void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
               SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed, std::vector<char> settled);
   std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved, const std::vector<char>& settled);
@@ -532,7 +552,61 @@ struct MovingBalls::Impl {
   // (mended locally, or nothing to mend), not remeshed: the settled
   // triangles of the next step keep that verdict (step).
   bool all_passed_ = false;
+  // The complex and topology of the next internal step, built beside this
+  // step's repair when its balls are known (build_ahead).
+  struct Ahead {
+    std::vector<Ball> balls;
+    std::optional<SkinComplex> complex;
+    SkinTopology topology;
+  };
+  Ahead ahead_;
+  tbb::task_group building_ahead_;
+  // The balls of the step after this one, when known, until build_ahead starts on them.
+  std::optional<std::vector<Ball>> after_;
 };
+
+// Starts building the next step's complex (after_), if known and not
+// started: once the step's judging is done, whose parallel passes it would
+// slow, so that it runs beside the mostly serial edits and patch.
+void MovingBalls::Impl::build_ahead() {
+  if (!after_) return;
+  forget_ahead();
+  ahead_.balls = std::move(*after_);
+  after_.reset();
+  building_ahead_.run([this] {
+    ahead_.complex.emplace(build_skin_complex(ahead_.balls, {options_.shrink}));
+    ahead_.topology = skin_topology(ahead_.complex->balls());
+  });
+}
+
+// The complex built ahead, when it was built for exactly `balls`; false
+// (and none kept) otherwise, or when its building failed.
+bool MovingBalls::Impl::take_ahead(const std::vector<Ball>& balls, std::optional<SkinComplex>& complex,
+                                   SkinTopology& topology) {
+  finish_ahead();
+  const bool same = ahead_.complex.has_value() && same_balls(ahead_.balls, balls);
+  if (same) {
+    complex = std::move(ahead_.complex);
+    topology = ahead_.topology;
+  }
+  ahead_ = Ahead{};
+  return same;
+}
+
+// Waits for the building ahead; when it failed, nothing built ahead is
+// kept (the step builds its own complex and reports what fails there).
+void MovingBalls::Impl::finish_ahead() {
+  try {
+    building_ahead_.wait();
+  } catch (...) {
+    ahead_.complex.reset();
+  }
+}
+
+void MovingBalls::Impl::forget_ahead() {
+  finish_ahead();
+  ahead_ = Ahead{};
+}
 
 MovingBalls::Impl::Impl(std::vector<Ball> balls, const MovingOptions& options, double t) : options_(options) {
   if (balls.empty()) contract_error("MovingBalls: the ball set is empty");
@@ -572,7 +646,10 @@ MovingBalls& MovingBalls::operator=(MovingBalls&&) noexcept = default;
 MovingBalls::~MovingBalls() = default;
 
 const MorphFrame& MovingBalls::advance_to(std::vector<Ball> balls, double t) {
-  return impl_->advance_to(std::move(balls), t);
+  return impl_->advance_to(std::move(balls), t, {});
+}
+const MorphFrame& MovingBalls::advance_to(std::vector<Ball> balls, double t, std::vector<Ball> next) {
+  return impl_->advance_to(std::move(balls), t, next);
 }
 const MorphFrame& MovingBalls::frame() const { return impl_->frame_; }
 const SkinComplex& MovingBalls::complex() const { return impl_->complex_; }
@@ -583,10 +660,10 @@ const MorphFrame& MovingBalls::advance_to(const std::vector<Eigen::Vector3d>& ce
   std::vector<Ball> balls = impl_->complex_.balls();
   if (centres.size() != balls.size()) contract_error("MovingBalls::advance_to: the number of centres differs");
   for (size_t i = 0; i < balls.size(); ++i) balls[i].center = centres[i];
-  return impl_->advance_to(std::move(balls), t);
+  return impl_->advance_to(std::move(balls), t, {});
 }
 
-const MorphFrame& MovingBalls::Impl::advance_to(std::vector<Ball> balls, double t) {
+const MorphFrame& MovingBalls::Impl::advance_to(std::vector<Ball> balls, double t, const std::vector<Ball>& next) {
   const std::vector<Ball> from = complex_.balls();
   if (balls.size() != from.size()) contract_error("MovingBalls::advance_to: the number of balls differs");
   check_balls(balls, "MovingBalls::advance_to");
@@ -598,8 +675,19 @@ const MorphFrame& MovingBalls::Impl::advance_to(std::vector<Ball> balls, double 
   const long steps = std::max(1L, static_cast<long>(std::ceil(farthest / options_.max_step)));
   frame_.stats = FrameStats{};
   frame_.stats.t = t;
-  for (long k = 1; k <= steps; ++k)
-    step(k == steps ? std::move(balls) : balls_between(from, balls, static_cast<double>(k) / static_cast<double>(steps)));
+  // Each step is told the balls of the step after it, when they are known.
+  const auto at = [&](long k) {
+    return k == steps ? balls : balls_between(from, balls, static_cast<double>(k) / static_cast<double>(steps));
+  };
+  bool next_usable = next.size() == balls.size();
+  for (const Ball& b : next) next_usable = next_usable && b.center.allFinite() && std::isfinite(b.weight);
+  for (long k = 1; k <= steps; ++k) {
+    std::vector<Ball> after;
+    if (k < steps) after = at(k + 1);
+    else if (next_usable) after = first_step(balls, next, options_.max_step);
+    step(at(k), after.empty() ? nullptr : &after);
+  }
+  finish_ahead();  // inside the call, so that the frame's seconds hold all its work
   FrameStats& s = frame_.stats;
   s.steps = steps;
   long kept = 0;
@@ -627,15 +715,19 @@ std::vector<int> MovingBalls::vertex_balls() const {
 
 // One internal step: the new complex, every vertex moved onto its skin,
 // judged, mended and certified (moving_balls.hpp).
-void MovingBalls::Impl::step(std::vector<Ball> balls) {
+void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* after) {
   FrameStats& s = frame_.stats;
   auto stage = Clock::now();
-  SkinComplex next = build_skin_complex(std::move(balls), {options_.shrink});
+  std::optional<SkinComplex> built;
+  SkinTopology topology;
+  const bool counted = take_ahead(balls, built, topology);
+  s.built_ahead += counted;
+  if (!built) built.emplace(build_skin_complex(std::move(balls), {options_.shrink}));
+  SkinComplex next = std::move(*built);
   // The certificate's count (CGAL's alpha shape, serial) runs beside the
   // rest of the step and is waited for before the repair.
-  SkinTopology topology;
   tbb::task_group counting;
-  counting.run([&] { topology = skin_topology(next.balls()); });
+  if (!counted) counting.run([&] { topology = skin_topology(next.balls()); });
   std::vector<int> critical = inside_critical_cells(next);
   const std::vector<Eigen::Matrix3d> rotations = neighbourhood_rotations(complex_, next.balls());
   const std::vector<char> quiet = quiet_balls(complex_, next);
@@ -673,7 +765,9 @@ void MovingBalls::Impl::step(std::vector<Ball> balls) {
   stage = Clock::now();
   counting.wait();
   s.seconds_complex += seconds_since(stage);
+  if (after && options_.build_ahead) after_ = *after;
   repair(next, topology, critical, moved, lost, stayed, std::move(settled));
+  build_ahead();  // when the repair did not start it
   // Ids mean continuous motion (moving_balls.hpp): a vertex that
   // moved farther in the step than its bound, by transport, relaxation,
   // an edit or a remesh, is another point of the skin and takes a new id.
@@ -779,6 +873,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   const long lost_count = std::count(lost.begin(), lost.end(), 1);
   if (lost_count > 0) return std::to_string(lost_count) + " vertices could not be put on the new skin";
   std::vector<char> failing = judge_and_relax(next, moved, settled);
+  build_ahead();
   long left = std::count(failing.begin(), failing.end(), 1);
   const auto stage = Clock::now();
   if (left > 0 && options_.repair.edits.enabled) {

@@ -445,6 +445,55 @@ TEST_CASE("moving balls: ubiquitin's NMR models 1 -> 2 -> 3 as one motion, ids k
   }
 }
 
+TEST_CASE("moving balls: complexes built ahead, the next call's told or not, make the same frames as built in step",
+          "[moving]") {
+  // 2k39 model 1 -> 3 (residues 1-10) in 6 frames, internal steps of at
+  // most 0.3 A, so that a frame takes several: each step's complex is
+  // built beside the repair of the step before, within a frame and across
+  // frames, against an engine that builds every complex in its own step.
+  // Frame 3 announces model 3 itself while frame 4 follows: what was
+  // built ahead is not the step asked for, and must not be used.
+  ReadOptions read;
+  const Molecule first = read_molecule(test::data_file("2k39_3models.pdb"), read);
+  read.model = 3;
+  Molecule last = read_molecule(test::data_file("2k39_3models.pdb"), read);
+  last = moved(std::move(last), align(first, last, AlignmentMethod::kabsch).motion);
+  const std::vector<Ball> from = balls_from_molecule(first, 0.5), to = balls_from_molecule(last, 0.5);
+  REQUIRE(from.size() == to.size());
+  const auto frame_balls = [&](int k) {
+    std::vector<Ball> balls = from;
+    for (size_t i = 0; i < balls.size(); ++i) balls[i].center += k / 6.0 * (to[i].center - from[i].center);
+    return k == 6 ? to : balls;
+  };
+  MovingOptions options;
+  options.max_step = 0.3;
+  MovingOptions serial = options;
+  serial.build_ahead = false;
+  MovingBalls plain(from, serial), ahead(from, options);
+  long built_ahead = 0, steps = 0;
+  for (int k = 1; k <= 6; ++k) {
+    INFO("frame " << k);
+    const std::vector<Ball> announced = k == 3 ? to : k < 6 ? frame_balls(k + 1) : std::vector<Ball>{};
+    const MorphFrame& a = plain.advance_to(frame_balls(k), k);
+    const MorphFrame& b = ahead.advance_to(frame_balls(k), k, announced);
+    REQUIRE(a.mesh.vertices.size() == b.mesh.vertices.size());
+    CHECK(a.mesh.vertices == b.mesh.vertices);
+    CHECK(a.mesh.triangles == b.mesh.triangles);
+    CHECK(a.mesh.cells == b.mesh.cells);
+    CHECK(a.ids == b.ids);
+    CHECK(a.stats.bad_triangles == b.stats.bad_triangles);
+    CHECK(a.stats.remeshed == b.stats.remeshed);
+    CHECK(a.stats.built_ahead == 0);
+    CHECK(b.stats.steps > 1);
+    // Every step but a frame's first is built ahead; the first too, unless
+    // the frame before announced other balls (frame 4) or nothing (frame 1).
+    CHECK(b.stats.built_ahead == b.stats.steps - (k == 1 || k == 4 ? 1 : 0));
+    built_ahead += b.stats.built_ahead;
+    steps += b.stats.steps;
+  }
+  CHECK(built_ahead >= steps - 2);
+}
+
 TEST_CASE("moving balls: ubiquitin's atoms in thermal motion, voids opening and closing, every frame valid", "[moving][large]") {
   // Each frame puts every atom at its rest place plus its own offset, up to
   // 0.15 A along each axis (seeded): an MD-like ensemble, whose small voids

@@ -111,6 +111,7 @@ struct FrameStats {
   bool thinned = false;        // meshed afresh (full_rebuild): more than max_over_fresh times a fresh mesh's triangles
   // Moving balls (moving_balls.hpp) only:
   long steps = 0;              // internal steps since the frame before (each a complex built from scratch)
+  long built_ahead = 0;        // of them, whose complex was built beside the step before's repair
   long reidentified = 0;       // vertices that moved farther than continuity allows and took a new id
   long settled = 0;            // triangles in skin the step left as it was, kept as passing unjudged
   double ids_kept = 0;         // share of the frame's vertices whose id the frame before had

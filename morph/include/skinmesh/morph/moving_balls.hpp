@@ -79,6 +79,11 @@ struct MovingOptions {
   // move of its cell's balls plus this times its longest mesh edge; one
   // that moved farther (it jumped to another piece of skin) takes a new id.
   double continuity = 1.0;  // dimensionless
+  // Each internal step's complex (and the skin's topology) is built beside
+  // the repair of the step before, which is mostly serial, when the step's
+  // balls are known then: the next step of a call, and a next call's first
+  // step when advance_to is told its balls. The frames are the same.
+  bool build_ahead = true;
   RelaxationOptions relaxation;  // for the corners of failing triangles
   // Every threshold of the repair (repair_policy.hpp), as the blend's but
   // for two. The largest patch: a third of the frame's vertices (with the
@@ -111,6 +116,13 @@ class MovingBalls {
   // non-finite ball, Error when a step cannot be meshed or certified (the
   // engine then holds no valid frame and is not to be advanced again).
   const MorphFrame& advance_to(std::vector<Ball> balls, double t = 0);
+  // The same, told the balls the next call will ask for (`next`, the same
+  // number of balls): the complex of that call's first internal step is
+  // built while this call's last step is mended, which is mostly serial
+  // work, on the other core. A next call that asks for other balls builds
+  // its own. The frames are the same either way; the call returns when
+  // the building ahead is done, so that its frame's seconds hold it.
+  const MorphFrame& advance_to(std::vector<Ball> balls, double t, std::vector<Ball> next);
   // The same with every ball's weight kept.
   const MorphFrame& advance_to(const std::vector<Eigen::Vector3d>& centres, double t = 0);
 
