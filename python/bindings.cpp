@@ -211,6 +211,7 @@ nlohmann::json stats_json(const FrameStats& s) {
           {"inserted", s.inserted},
           {"removed", s.removed},
           {"steps", s.steps},
+          {"steps_built_ahead", s.built_ahead},
           {"reidentified", s.reidentified},
           {"settled", s.settled},
           {"ids_kept", s.ids_kept},
@@ -454,18 +455,20 @@ class PyMovingBalls {
       weights_.push_back(convention == WeightConvention::GrowBySkin ? r * r / options_.shrink : r * r);
     }
   }
-  Frame advance_to(const py::array_t<double, py::array::c_style | py::array::forcecast>& centres, double t) {
-    const std::vector<Eigen::Vector3d> points = points_from(centres, "centres");
-    if (points.size() != weights_.size())
-      throw py::value_error("centres has " + std::to_string(points.size()) + " rows, radii " +
-                            std::to_string(weights_.size()));
-    std::vector<Ball> balls(points.size());
-    for (size_t i = 0; i < balls.size(); ++i) balls[i] = {points[i], weights_[i]};
+  // `next`: the centres the call after this one will pass, or None
+  // (MovingBalls::advance_to builds that call's first complex beside this
+  // call's repair; the frames are the same).
+  Frame advance_to(const py::array_t<double, py::array::c_style | py::array::forcecast>& centres, double t,
+                   const py::object& next) {
+    std::vector<Ball> balls = balls_at(centres, "centres");
+    std::vector<Ball> ahead;
+    if (!next.is_none())
+      ahead = balls_at(next.cast<py::array_t<double, py::array::c_style | py::array::forcecast>>(), "next");
     std::vector<int> atom, patch;
     {
       py::gil_scoped_release release;
       if (!engine_) engine_ = std::make_unique<MovingBalls>(std::move(balls), options_, t);
-      else engine_->advance_to(std::move(balls), t);
+      else engine_->advance_to(std::move(balls), t, std::move(ahead));
       atom = engine_->vertex_balls();
       for (int c : engine_->frame().mesh.cells) patch.push_back(engine_->complex().cell(c).dim);
     }
@@ -475,6 +478,17 @@ class PyMovingBalls {
   }
 
  private:
+  std::vector<Ball> balls_at(const py::array_t<double, py::array::c_style | py::array::forcecast>& centres,
+                             const char* name) const {
+    const std::vector<Eigen::Vector3d> points = points_from(centres, name);
+    if (points.size() != weights_.size())
+      throw py::value_error(std::string(name) + " has " + std::to_string(points.size()) + " rows, radii " +
+                            std::to_string(weights_.size()));
+    std::vector<Ball> balls(points.size());
+    for (size_t i = 0; i < balls.size(); ++i) balls[i] = {points[i], weights_[i]};
+    return balls;
+  }
+
   MovingOptions options_;
   std::vector<double> weights_;
   bool check_ = true;
@@ -694,7 +708,9 @@ PYBIND11_MODULE(_skinmesh, m) {
       .def(py::init<const py::array_t<double, py::array::c_style | py::array::forcecast>&, const py::kwargs&>(),
            py::arg("radii"))
       .def("advance_to", &PyMovingBalls::advance_to, py::arg("centres"), py::arg("t") = 0.0,
-           "The frame of the balls at these centres (the first call meshes, later ones carry the mesh on).");
+           py::arg("next") = py::none(),
+           "The frame of the balls at these centres (the first call meshes, later ones carry the mesh on); "
+           "`next`, the centres of the call after, lets the engine prepare that call beside this one.");
   py::class_<PyMorph>(m, "Morph")
       .def(py::init<const py::object&, const py::object&, const py::kwargs&>(), py::arg("source"), py::arg("target"))
       .def_property_readonly("frame", &PyMorph::frame)

@@ -111,6 +111,26 @@ def test_moving_balls_keep_ids_and_every_frame_holds():
         assert np.allclose(f.vertices, first.vertices + np.array([0.3 * k, 0, 0]), atol=1e-9)
 
 
+def test_moving_balls_told_the_next_centres_make_the_same_frames():
+    lines = [l for l in open(data("pept.pdb")) if l.startswith(("ATOM", "HETATM"))]
+    centres = np.array([[float(l[30:38]), float(l[38:46]), float(l[46:54])] for l in lines])
+    radii = np.full(len(centres), 1.7)
+    middle = centres.mean(axis=0)
+    path = [middle + (centres - middle) * (1 + 0.02 * k) for k in range(5)]  # swelling: the mesh is mended
+    plain = skinmesh.MovingBalls(radii)
+    frames = [plain.advance_to(c, float(k)) for k, c in enumerate(path)]
+    told = list(skinmesh.MovingBalls(radii).frames(path))  # each call told the next centres
+    assert len(told) == len(frames)
+    for f, g in zip(frames, told):
+        assert np.array_equal(f.vertices, g.vertices)
+        assert np.array_equal(f.triangles, g.triangles)
+        assert np.array_equal(f.ids, g.ids)
+    assert sum(f.report.get("steps_built_ahead", 0) for f in frames) == 0
+    assert sum(g.report["steps_built_ahead"] for g in told[1:]) >= len(told) - 2  # all but the first call's
+    with pytest.raises(ValueError):
+        skinmesh.MovingBalls(radii).advance_to(centres, 0.0, next=centres[:3])
+
+
 def test_morph_frames_are_valid_and_ids_continue():
     morph = skinmesh.Morph(data("2k39_3models.pdb"), data("2k39_3models.pdb"), model=1)
     assert morph.matched  # one molecule: its atoms travel
