@@ -335,7 +335,10 @@ bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
     if (!faces_out(t)) return false;
     renamed.push_back(t);
   }
-  // Judged before the edit, on a copy of each triangle.
+  // The shape first, which needs no skin and refuses most thinning
+  // contractions; then judged whole before the edit, on a copy of each triangle.
+  for (const Triangle& t : renamed)
+    if (!shape_passes({at(t[0]), at(t[1]), at(t[2])}, accept_.min_angle)) return false;
   for (size_t i = 0; i < fan.size(); ++i) {
     const Triangle saved = tri(fan[i]);
     mesh_.triangles[static_cast<size_t>(fan[i])] = renamed[i];

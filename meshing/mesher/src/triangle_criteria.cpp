@@ -69,13 +69,23 @@ TriangleDefect triangle_defect(const SkinComplex& complex, const RestrictedTrian
   if (radius > target / std::sqrt(3.0)) return TriangleDefect::size;
   if ((triangle.ball_center - circumcenter).norm() > kToleranceMargin * options.tolerance)
     return TriangleDefect::distance;
-  // Triangle shape: circumradius over shortest edge, at most 1 / (2 sin(min_angle)).
+  return shape_passes(triangle.corners, options.min_angle) ? TriangleDefect::none : TriangleDefect::shape;
+}
+
+bool shape_passes(const std::array<Eigen::Vector3d, 3>& corners, double min_angle) {
+  const Eigen::Vector3d& p0 = corners[0];
+  const Eigen::Vector3d u = corners[1] - p0, w = corners[2] - p0;
+  const Eigen::Vector3d uxw = u.cross(w);
+  const double cross2 = uxw.squaredNorm();
+  if (!(cross2 > 0)) return false;
+  const Eigen::Vector3d circumcenter =
+      p0 + (u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)) / (2.0 * cross2);
+  // Circumradius over shortest edge, at most 1 / (2 sin(min_angle)).
   const double circumradius = std::sqrt((circumcenter - p0).squaredNorm());
   const double shortest =
-      std::sqrt(std::min({u.squaredNorm(), w.squaredNorm(), (triangle.corners[2] - triangle.corners[1]).squaredNorm()}));
-  const double max_radius_edge = 1.0 / (2.0 * std::sin(options.min_angle * M_PI / 180.0));
-  if (!(circumradius <= max_radius_edge * shortest)) return TriangleDefect::shape;
-  return TriangleDefect::none;
+      std::sqrt(std::min({u.squaredNorm(), w.squaredNorm(), (corners[2] - corners[1]).squaredNorm()}));
+  const double max_radius_edge = 1.0 / (2.0 * std::sin(min_angle * M_PI / 180.0));
+  return circumradius <= max_radius_edge * shortest;
 }
 
 bool faces_outward(const SkinComplex& complex, const RestrictedTriangle& triangle) {

@@ -102,6 +102,11 @@ std::optional<RestrictedTriangle> restricted_triangle(const SkinComplex& complex
                                                       const std::array<Eigen::Vector3d, 3>& corners, double reach,
                                                       int hint = -1);
 
+// The shape criterion alone, as triangle_defect applies it: circumradius
+// over shortest edge at most 1 / (2 sin(min_angle)), corners not collinear.
+// It needs no skin: a cheap first test of a triangle an edit would make.
+bool shape_passes(const std::array<Eigen::Vector3d, 3>& corners, double min_angle);
+
 // The first criterion the triangle fails, in the order above, or none.
 TriangleDefect triangle_defect(const SkinComplex& complex, const RestrictedTriangle& triangle,
                                const MeshingOptions& options);
