@@ -457,7 +457,8 @@ TEST_CASE("moving balls: complexes built ahead, the next call's told or not, mak
   const Molecule first = read_molecule(test::data_file("2k39_3models.pdb"), read);
   read.model = 3;
   Molecule last = read_molecule(test::data_file("2k39_3models.pdb"), read);
-  last = moved(std::move(last), align(first, last, AlignmentMethod::kabsch).motion);
+  const RigidMotion fit = align(first, last, AlignmentMethod::kabsch).motion;  // before last is moved from
+  last = moved(std::move(last), fit);
   const std::vector<Ball> from = balls_from_molecule(first, 0.5), to = balls_from_molecule(last, 0.5);
   REQUIRE(from.size() == to.size());
   const auto frame_balls = [&](int k) {
