@@ -4,6 +4,7 @@
 // angle bound and the grader; ids kept by surviving vertices and never
 // reused. The acceptance tests on real pairs: test_morph_pairs.cpp.
 #include "test_support.hpp"
+#include "same_frames.hpp"
 #include "blend_events.hpp"
 #include "two_balls.hpp"
 
@@ -104,13 +105,7 @@ TEST_CASE("advance_to with the next frame announced makes the same frames, also 
     INFO("t = " << t);
     const MorphFrame& a = plain.advance_to(t);
     const MorphFrame& b = ahead.advance_to(t, announced);
-    REQUIRE(a.mesh.vertices.size() == b.mesh.vertices.size());
-    CHECK(a.mesh.vertices == b.mesh.vertices);
-    CHECK(a.mesh.triangles == b.mesh.triangles);
-    CHECK(a.mesh.cells == b.mesh.cells);
-    CHECK(a.ids == b.ids);
-    CHECK(a.stats.bad_triangles == b.stats.bad_triangles);
-    CHECK(a.stats.remeshed == b.stats.remeshed);
+    test::check_same_frames(a, b);
     mended_without_remesh += b.stats.repaired && !b.stats.remeshed;
   }
   CHECK(mended_without_remesh > 0);  // the moving ahead overlapped edits or a patch
