@@ -91,6 +91,7 @@ Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const Rela
       ++k;
     }
   rejudge_moved(complex, mesh, corners, criteria, j.failing);
+  j.relaxed = std::move(corners);
   j.seconds_judge += seconds_since(stage);
   return j;
 }

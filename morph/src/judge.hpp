@@ -56,6 +56,7 @@ long rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
 // knows it passed and that nothing it is judged by changed.
 struct Judged {
   std::vector<char> failing;       // per triangle, after the relaxation
+  std::vector<char> relaxed;       // per vertex, 1 where the relaxation moved it (empty: none moved)
   long failing_before_relax = 0;   // triangles failing as transported
   long settled = 0;                // triangles taken as passing unjudged (all corners settled)
   double seconds_judge = 0, seconds_relax = 0;

@@ -158,11 +158,47 @@ std::vector<char> quiet_balls(const SkinComplex& from, const SkinComplex& to) {
   return with_all_neighbours(from, to, stayed);
 }
 
+// Per ball, whether it and its neighbours in the regular triangulation of
+// `from` moved in the step as one rigid body (to kRigid Angstrom), radii
+// kept: by the ball's neighbourhood rotation and its own translation. A
+// ball that stayed moved rigidly. Hidden balls: no.
+std::vector<char> rigidly_moved_balls(const SkinComplex& from, const std::vector<Ball>& to,
+                                      const std::vector<Eigen::Matrix3d>& rotations) {
+  constexpr double kRigid = 1e-9;
+  const std::vector<Ball>& old = from.balls();
+  std::vector<char> rigid(old.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, old.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t b = r.begin(); b != r.end(); ++b) {
+      const int cell = from.vertex_cell(static_cast<int>(b));
+      if (cell < 0 || old[b].weight != to[b].weight) continue;
+      const auto carried = [&](int i) {
+        const size_t k = static_cast<size_t>(i);
+        const Eigen::Vector3d expected = to[b].center + rotations[b] * (old[k].center - old[b].center);
+        return old[k].weight == to[k].weight && (to[k].center - expected).norm() <= kRigid;
+      };
+      bool all = true;
+      for (auto c = from.cofaces_begin(cell); all && c != from.cofaces_end(cell); ++c)
+        if (!c->beyond) all = carried(c->ball);
+      rigid[b] = all;
+    }
+  });
+  return rigid;
+}
+
 bool cell_of_flagged_balls(const MixedCell& cell, const std::vector<char>& flags) {
   for (int i = 0; i <= cell.dim; ++i)
     if (!flags[static_cast<size_t>(cell.balls[static_cast<size_t>(i)])]) return false;
   return true;
 }
+
+// Per vertex of a transported step, what the step before settled there:
+// `verdict` where the triangles around it keep the verdicts they had (the
+// skin around it is as it was), `thinning` where thinning would decide as
+// it did (its cell's balls and their neighbours moved as one rigid body:
+// mend_by_edits' `still`).
+struct Settled {
+  std::vector<char> verdict, thinning;
+};
 
 // Where a vertex was before a step, and how far it may move in the step
 // and keep its id: the largest move of its cell's balls plus `continuity`
@@ -529,13 +565,13 @@ struct MovingBalls::Impl {
   void finish_ahead();
   void forget_ahead();
   void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
-              SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed, std::vector<char> settled);
-  std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved, const std::vector<char>& settled);
+              SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed, Settled settled);
+  std::vector<char> judge_and_relax(const SkinComplex& next, SurfaceMesh& moved, Settled& settled);
   std::string mend_locally(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
                            SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed,
-                           std::vector<char> settled, detail::LocalRepairOptions& local);
+                           Settled settled, detail::LocalRepairOptions& local);
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
-                     SurfaceMesh& moved, std::vector<char>& lost, std::vector<char>& settled, long& euler_change);
+                     SurfaceMesh& moved, std::vector<char>& lost, Settled& settled, long& euler_change);
   bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria,
               const std::vector<SkinSample>& seeds);
   MeshingOptions repair_criteria() const { return options_.frames; }
@@ -750,12 +786,17 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // it as before, so it keeps the verdict it had: it passed, when the step
   // before ended with every triangle judged passing.
   const std::vector<char> settled_balls = with_all_neighbours(complex_, next, quiet);
-  std::vector<char> lost(n, 0), stayed(n, 0), settled(n, 0);
+  // Thinning would decide as it did where the cells around a vertex moved
+  // as one rigid body: the same edge lengths, targets and fans.
+  const std::vector<char> rigid_balls = rigidly_moved_balls(complex_, next.balls(), rotations);
+  std::vector<char> lost(n, 0), stayed(n, 0);
+  Settled settled{std::vector<char>(n, 0), std::vector<char>(n, 0)};
   for (size_t v = 0; v < n; ++v) {
     lost[v] = fates[v] == VertexFate::lost;
     stayed[v] = fates[v] == VertexFate::moved || fates[v] == VertexFate::kept;
-    settled[v] = all_passed_ && fates[v] == VertexFate::kept &&
-                 cell_of_flagged_balls(next.cell(moved.cells[v]), settled_balls);
+    settled.verdict[v] = all_passed_ && fates[v] == VertexFate::kept &&
+                         cell_of_flagged_balls(next.cell(moved.cells[v]), settled_balls);
+    settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(next.cell(moved.cells[v]), rigid_balls);
     s.moved += stayed[v];
     s.relocated += fates[v] == VertexFate::relocated;
     s.lost += lost[v];
@@ -789,7 +830,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
 // (moving_balls.hpp); throws Error when no mesh of the step can be certified.
 void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
                          SurfaceMesh& moved, std::vector<char>& lost, const std::vector<char>& stayed,
-                         std::vector<char> settled) {
+                         Settled settled) {
   detail::LocalRepairOptions local;  // the step's topology changes, among them
   const std::string because = mend_locally(next, topology, critical, moved, lost, stayed, std::move(settled), local);
   all_passed_ = because.empty();
@@ -830,10 +871,12 @@ void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topo
 }
 
 // Per triangle of `moved`, whether it fails the frame criteria, after the
-// corners of those that failed were relaxed along the skin once.
-std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved,
-                                                     const std::vector<char>& settled) {
-  detail::Judged j = detail::judge_and_relax(next, moved, options_.relaxation, options_.frames, &settled);
+// corners of those that failed were relaxed along the skin once; the
+// relaxed vertices are no longer `settled`.
+std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved, Settled& settled) {
+  detail::Judged j = detail::judge_and_relax(next, moved, options_.relaxation, options_.frames, &settled.verdict);
+  for (size_t v = 0; v < j.relaxed.size() && v < settled.verdict.size(); ++v)
+    if (j.relaxed[v]) settled.verdict[v] = settled.thinning[v] = 0;
   FrameStats& s = frame_.stats;
   s.settled += j.settled;
   s.bad_triangles += j.failing_before_relax;
@@ -848,7 +891,7 @@ std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, Su
 // vertices, and `local` holds the step's topology changes.
 std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinTopology& topology,
                                       const std::vector<int>& critical, SurfaceMesh& moved, std::vector<char>& lost,
-                                      const std::vector<char>& stayed, std::vector<char> settled,
+                                      const std::vector<char>& stayed, Settled settled,
                                       detail::LocalRepairOptions& local) {
   FrameStats& s = frame_.stats;
   // Where the topology changed; a component or void that vanished is
@@ -879,7 +922,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   if (left > 0 && options_.repair.edits.enabled) {
     detail::RepairResult edited =
         detail::mend_by_edits(next, std::move(moved), failing, options_.frames, options_.repair.edits, &frame_.ids,
-                              &refused_thinning_);
+                              &refused_thinning_, &settled.thinning);
     detail::take_ids_and_counts(edited, frame_.ids, next_id_, s);
     moved = std::move(edited.mesh);
     failing = std::move(edited.failing);
@@ -917,7 +960,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
 // `euler_change` gains 2 for each, since the repair counts from the mesh
 // without them. False when one is not found as a component of its own.
 bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
-                                SurfaceMesh& moved, std::vector<char>& lost, std::vector<char>& settled,
+                                SurfaceMesh& moved, std::vector<char>& lost, Settled& settled,
                                 long& euler_change) {
   std::vector<char> found;
   const std::vector<char> gone =
@@ -928,15 +971,13 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
   std::vector<int> kept_from;
   moved = detail::used_part(moved, keep, kept_from);
   std::vector<long> ids;
-  std::vector<char> kept_lost, kept_settled;
-  for (int v : kept_from) {
-    ids.push_back(frame_.ids[static_cast<size_t>(v)]);
-    kept_lost.push_back(lost[static_cast<size_t>(v)]);
-    kept_settled.push_back(settled.empty() ? 0 : settled[static_cast<size_t>(v)]);
-  }
+  for (int v : kept_from) ids.push_back(frame_.ids[static_cast<size_t>(v)]);
   frame_.ids = std::move(ids);
-  lost = std::move(kept_lost);
-  settled = std::move(kept_settled);
+  for (std::vector<char>* marks : {&lost, &settled.verdict, &settled.thinning}) {
+    std::vector<char> kept;
+    for (int v : kept_from) kept.push_back(marks->empty() ? 0 : (*marks)[static_cast<size_t>(v)]);
+    *marks = std::move(kept);
+  }
   euler_change += 2 * static_cast<long>(vanished.size());
   return true;
 }

@@ -104,7 +104,8 @@ double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eig
 // triangle of a closed oriented manifold), edited in place.
 class Editor {
  public:
-  Editor(const SkinComplex& complex, SurfaceMesh mesh, const MeshingOptions& accept, const EditPolicy& options)
+  Editor(const SkinComplex& complex, SurfaceMesh mesh, const MeshingOptions& accept, const EditPolicy& options,
+         const std::vector<char>* still)
       : complex_(complex),
         mesh_(std::move(mesh)),
         accept_(accept),
@@ -117,6 +118,7 @@ class Editor {
         mesh_.normals[v] = complex_.evaluate(mesh_.vertices[v], mesh_.cells[v]).gradient.normalized();
     }
     alive_.assign(mesh_.triangles.size(), 1);
+    if (still != nullptr && still->size() == mesh_.vertices.size()) still_ = *still;
     corner_face_.assign(mesh_.vertices.size(), -1);
     for (int f = 0; f < static_cast<int>(mesh_.triangles.size()); ++f) attach(f);
   }
@@ -169,6 +171,8 @@ class Editor {
   bool try_contract(int f, std::vector<int>& touched);
   bool contract(int gone, int kept, std::vector<int>& touched);
   void thin_crowded(std::unordered_map<int, int>& seen, const std::vector<long>* ids, RefusedEdges* refused);
+  void unsettle(const std::vector<int>& touched);
+  std::vector<char> near_change() const;
 
   const SkinComplex& complex_;
   SurfaceMesh mesh_;
@@ -176,6 +180,7 @@ class Editor {
   EditPolicy options_;
   std::vector<char> alive_;
   std::vector<int> corner_face_;  // per vertex: a triangle it is a corner of (-1: gone)
+  std::vector<char> still_;       // per vertex of the mesh given (mend_by_edits); empty: none
   EdgeIndex edges_;
   size_t vertices_before_;
   long splits_ = 0, flips_ = 0, contractions_ = 0, thin_tried_ = 0;
@@ -316,13 +321,8 @@ bool Editor::try_split(int f, std::vector<int>& touched) {
 bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
   const int f = face_of(gone, kept), g = face_of(kept, gone);
   if (f < 0 || g < 0) return false;
-  const std::vector<int> around_gone = ring(gone), around_kept = ring(kept);
-  if (around_gone.size() < 3 || around_kept.size() < 3 || around_gone.size() + around_kept.size() < 8) return false;
-  long common = 0;
-  for (int v : around_gone) common += std::count(around_kept.begin(), around_kept.end(), v);
-  if (common != 2) return false;
-  // The corners opposite the edge lose a neighbour: each keeps three.
-  if (ring(third(f, gone, kept)).size() < 4 || ring(third(g, gone, kept)).size() < 4) return false;
+  const std::vector<int> around_gone = ring(gone);
+  if (around_gone.size() < 3) return false;
   std::vector<int> fan;  // triangles around `gone` that stay, with `kept` in its place
   for (int v : around_gone) {
     const int h = face_of(gone, v);
@@ -335,10 +335,18 @@ bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
     if (!faces_out(t)) return false;
     renamed.push_back(t);
   }
-  // The shape first, which needs no skin and refuses most thinning
-  // contractions; then judged whole before the edit, on a copy of each triangle.
+  // The tests that need no skin first, the shape (which refuses most
+  // thinning contractions) before the link condition, whose rings cost more.
   for (const Triangle& t : renamed)
     if (!shape_passes({at(t[0]), at(t[1]), at(t[2])}, accept_.min_angle)) return false;
+  const std::vector<int> around_kept = ring(kept);
+  if (around_kept.size() < 3 || around_gone.size() + around_kept.size() < 8) return false;
+  long common = 0;
+  for (int v : around_gone) common += std::count(around_kept.begin(), around_kept.end(), v);
+  if (common != 2) return false;
+  // The corners opposite the edge lose a neighbour: each keeps three.
+  if (ring(third(f, gone, kept)).size() < 4 || ring(third(g, gone, kept)).size() < 4) return false;
+  // Then judged whole before the edit, on a copy of each triangle.
   for (size_t i = 0; i < fan.size(); ++i) {
     const Triangle saved = tri(fan[i]);
     mesh_.triangles[static_cast<size_t>(fan[i])] = renamed[i];
@@ -378,10 +386,36 @@ bool Editor::try_contract(int f, std::vector<int>& touched) {
   return contract(std::max(a, b), std::min(a, b), touched) || contract(std::min(a, b), std::max(a, b), touched);
 }
 
+// The corners of the triangles `touched` (made by an edit) are no longer still.
+void Editor::unsettle(const std::vector<int>& touched) {
+  for (int h : touched)
+    for (int v : tri(h))
+      if (static_cast<size_t>(v) < still_.size()) still_[static_cast<size_t>(v)] = 0;
+}
+
+// Per vertex, whether a triangle around it has a corner that is not still
+// (a vertex an edit made is not): a contraction of an edge between two
+// vertices that are not near a change would judge a congruent fan, on a
+// congruent skin, as in the frame before. Every vertex without `still_`.
+std::vector<char> Editor::near_change() const {
+  const size_t n = mesh_.vertices.size();
+  if (still_.empty()) return std::vector<char>(n, 1);
+  std::vector<char> near(n, 0);
+  const auto still = [&](int v) { return static_cast<size_t>(v) < still_.size() && still_[static_cast<size_t>(v)]; };
+  for (size_t f = 0; f < mesh_.triangles.size(); ++f) {
+    if (!alive_[f]) continue;
+    const Triangle& t = mesh_.triangles[f];
+    if (still(t[0]) && still(t[1]) && still(t[2])) continue;
+    for (int v : t) near[static_cast<size_t>(v)] = 1;
+  }
+  return near;
+}
+
 // Every edge shorter than thin_below times the target edge length at its
 // ends is contracted where that keeps every guarantee (contract): splits
 // add vertices where the skin stretches, and this takes them away where it
-// shrinks, so that the vertex count follows the surface.
+// shrinks, so that the vertex count follows the surface. With still marks,
+// only edges near a change are tried (near_change).
 void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<long>* ids, RefusedEdges* refused) {
   const size_t n = mesh_.vertices.size();
   RefusedEdges before;
@@ -404,11 +438,18 @@ void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<
     refused->emplace(*key, std::make_pair(length_then, age + 1));
     return true;
   };
-  std::vector<double> target(n, 0);
+  std::vector<char> near = near_change();
+  std::vector<double> target(n, -1);  // -1: not worked out yet
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v)
-      if (corner_face_[v] >= 0) target[v] = target_edge_length(complex_, mesh_.vertices[v], mesh_.cells[v], accept_);
+      if (corner_face_[v] >= 0 && near[v])
+        target[v] = target_edge_length(complex_, mesh_.vertices[v], mesh_.cells[v], accept_);
   });
+  const auto target_at = [&](int v) {
+    double& t = target[static_cast<size_t>(v)];
+    if (t < 0) t = target_edge_length(complex_, at(v), mesh_.cells[static_cast<size_t>(v)], accept_);
+    return t;
+  };
   std::vector<int> touched;
   const size_t faces = mesh_.triangles.size();
   for (size_t f = 0; f < faces; ++f) {
@@ -417,7 +458,8 @@ void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<
       const Triangle& t = mesh_.triangles[f];
       const int a = t[k], b = t[(k + 1) % 3];
       if (a > b) continue;  // each edge once
-      const double limit = options_.thin_below * std::min(target[static_cast<size_t>(a)], target[static_cast<size_t>(b)]);
+      if (!near[static_cast<size_t>(a)] && !near[static_cast<size_t>(b)]) continue;
+      const double limit = options_.thin_below * std::min(target_at(a), target_at(b));
       const double length = (at(a) - at(b)).norm();
       if (!(length < limit)) continue;
       const auto key = key_of(a, b);
@@ -428,7 +470,10 @@ void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<
         if (key) refused->emplace(*key, std::make_pair(length, 0));
         continue;
       }
-      for (int h : touched) seen.emplace(h, 0);
+      for (int h : touched) {
+        seen.emplace(h, 0);
+        for (int v : tri(h)) near[static_cast<size_t>(v)] = 1;  // its fan changed
+      }
       break;  // this triangle is gone
     }
   }
@@ -457,6 +502,7 @@ RepairResult Editor::run(const std::vector<char>& failing, const std::vector<lon
     if (!mended) mended = try_split(f, touched);
     if (!mended) continue;  // left failing
     ++edits;
+    unsettle(touched);
     for (int h : touched) {
       queue.push_back(h);
       seen[h] = generation + 1;
@@ -483,8 +529,8 @@ RepairResult Editor::run(const std::vector<char>& failing, const std::vector<lon
 
 RepairResult mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
                       const MeshingOptions& accept, const EditPolicy& options, const std::vector<long>* ids,
-                      RefusedEdges* refused) {
-  Editor editor(complex, std::move(mesh), accept, options);
+                      RefusedEdges* refused, const std::vector<char>* still) {
+  Editor editor(complex, std::move(mesh), accept, options, still);
   return editor.run(failing, ids, refused);
 }
 

@@ -35,9 +35,16 @@ using RefusedEdges = std::map<std::pair<long, long>, std::pair<double, int>>;
 // skin of `complex`; the others are taken to pass. With `ids` (per vertex of
 // `mesh`, stable from frame to frame) and `refused`, thinning skips the
 // edges refused before (EditPolicy::retry_shrink) and `refused` becomes
-// this frame's.
+// this frame's. With `still` (per vertex of `mesh`: 1 where the vertex and
+// the skin around it moved, since the frame before was thinned, only as one
+// rigid body), thinning tries only edges with an end whose triangles have a
+// corner that is not still or that an edit of this frame touched. The
+// others were tried when the frame before was thinned (or made after it by
+// a local patch, whose refinement spaced them) and would be judged again on
+// a congruent fan and skin.
 RepairResult mend_by_edits(const SkinComplex& complex, SurfaceMesh mesh, const std::vector<char>& failing,
                       const MeshingOptions& accept, const EditPolicy& options = {},
-                      const std::vector<long>* ids = nullptr, RefusedEdges* refused = nullptr);
+                      const std::vector<long>* ids = nullptr, RefusedEdges* refused = nullptr,
+                      const std::vector<char>* still = nullptr);
 
 }  // namespace skinmesh::detail

@@ -18,6 +18,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <numeric>
 
 using namespace skinmesh;
@@ -89,6 +90,58 @@ TEST_CASE("edits: thinning skips an edge refused in the frame before until it sh
   SECTION("without ids every short edge is tried") {
     const detail::RepairResult plain = detail::mend_by_edits(complex, f.mesh, none_failing, accept, options);
     CHECK(plain.thin_tried == first.thin_tried);
+  }
+}
+
+TEST_CASE("edits: with still marks, thinning tries only edges near a vertex that is not still", "[morph]") {
+  const PeptFrame f = pept_frame();
+  const std::vector<char> none_failing(f.mesh.triangles.size(), 0);
+  const EditPolicy options;
+  const size_t n = f.mesh.vertices.size();
+  auto thin = [&](const std::vector<char>* still) {
+    return detail::mend_by_edits(f.complex, f.mesh, none_failing, f.accept, options, nullptr, nullptr, still);
+  };
+  const detail::RepairResult plain = thin(nullptr);
+  REQUIRE(plain.thin_tried > 0);
+  REQUIRE(plain.counts.contractions > 0);
+
+  SECTION("every vertex still: no edge is tried and the mesh is kept") {
+    const std::vector<char> all(n, 1);
+    const detail::RepairResult kept = thin(&all);
+    CHECK(kept.thin_tried == 0);
+    CHECK(kept.counts.contractions == 0);
+    CHECK(kept.mesh.triangles == f.mesh.triangles);
+  }
+  SECTION("no vertex still: the same as without marks") {
+    const std::vector<char> none(n, 0);
+    const detail::RepairResult same = thin(&none);
+    CHECK(same.thin_tried == plain.thin_tried);
+    CHECK(same.mesh.triangles == plain.mesh.triangles);
+  }
+  SECTION("half the vertices still: only edges with an end near the other half are tried") {
+    std::vector<double> x(n);
+    for (size_t v = 0; v < n; ++v) x[v] = f.mesh.vertices[v].x();
+    std::vector<double> sorted = x;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(n / 2), sorted.end());
+    const double median = sorted[n / 2];
+    std::vector<char> still(n, 0);
+    for (size_t v = 0; v < n; ++v) still[v] = x[v] > median;
+    const detail::RepairResult half = thin(&still);
+    CHECK(half.thin_tried > 0);
+    CHECK(half.thin_tried < plain.thin_tried);
+    // A vertex the thinning took away had a neighbour that was not still, or
+    // lay beside a contraction (whose fan is a change in turn).
+    std::vector<char> kept(n, 0);
+    for (long v : half.origin)
+      if (v >= 0) kept[static_cast<size_t>(v)] = 1;
+    long far_removed = 0, removed = 0;
+    for (size_t v = 0; v < n; ++v) {
+      if (kept[v]) continue;
+      ++removed;
+      far_removed += x[v] > median + 5.0;  // Angstrom: several edges into the still half
+    }
+    CHECK(removed > 0);
+    CHECK(far_removed == 0);
   }
 }
 
