@@ -938,22 +938,51 @@ std::vector<SkinSample> seeds_at_changes(const SkinComplex& complex, const std::
   return points_at_changes(complex, changes, true);
 }
 
+namespace {
+
+// The attempt counts of `earlier` added to `later`'s.
+void add_attempts(const RepairResult& earlier, RepairResult& later) {
+  later.attempts += earlier.attempts;
+  later.context_vertices += earlier.context_vertices;
+  later.attempted_triangles += earlier.attempted_triangles;
+}
+
 // A local context first (PatchPolicy::local_context_first); when that
 // fails, the whole region's measure, unless the local patch already took
-// nearly the whole frame (a larger context would too).
-RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
-                           const MeshingOptions& repair, const MeshingOptions& accept,
-                           const LocalRepairOptions& options) {
+// nearly the whole frame (a larger context would too: `too_large`).
+RepairResult patch_with_contexts(const SkinComplex& complex, const SurfaceMesh& given,
+                                 const std::vector<char>& failing, const MeshingOptions& repair,
+                                 const MeshingOptions& accept, const LocalRepairOptions& options, bool& too_large) {
+  too_large = false;
   if (!options.policy.local_context_first) return whole_context_patch(complex, given, failing, repair, accept, options);
   PiecesFailure failure;
   const Retry retry = options.policy.retry_in_pieces ? piecewise(options.policy) : Retry::whole;
   RepairResult local = patch_attempts(complex, given, failing, repair, accept, options, retry, 1.0, failure);
+  too_large = failure.too_large;
   if (local.ok || failure.too_large) return local;
   RepairResult whole = whole_context_patch(complex, given, failing, repair, accept, options);
-  whole.attempts += local.attempts;
-  whole.context_vertices += local.context_vertices;
-  whole.attempted_triangles += local.attempted_triangles;
+  add_attempts(local, whole);
   return whole;
+}
+
+}  // namespace
+
+// The patch with its contexts; when it fails, once more with
+// PatchPolicy::wider_rings more rings.
+RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
+                           const MeshingOptions& repair, const MeshingOptions& accept,
+                           const LocalRepairOptions& options) {
+  bool too_large = false;
+  RepairResult first = patch_with_contexts(complex, given, failing, repair, accept, options, too_large);
+  if (first.ok || too_large || options.policy.wider_rings <= 0) return first;
+  LocalRepairOptions wider = options;
+  wider.policy.rings += options.policy.wider_rings;
+  RepairResult again = patch_with_contexts(complex, given, failing, repair, accept, wider, too_large);
+  add_attempts(first, again);
+  if (!again.ok)
+    again.failed_because = first.failed_because + "; with " + std::to_string(wider.policy.rings) +
+                           " rings: " + again.failed_because;
+  return again;
 }
 
 }  // namespace skinmesh::detail

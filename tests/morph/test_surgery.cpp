@@ -307,3 +307,38 @@ TEST_CASE("local repair: a patch first takes a context near each of its vertices
   CHECK(local.context_vertices * whole.attempts < whole.context_vertices * local.attempts);
   check_patched(f, local);
 }
+
+TEST_CASE("local repair: a patch that fails is tried once more from the start with wider_rings more rings", "[morph]") {
+  SECTION("allowed one attempt a round, the patch fails, and its second round meshes a wider region") {
+    // The strand's last 32 atoms turned by 5 degrees need more than one
+    // attempt; each round is a local context's attempt and a whole one's.
+    TurnedStrand f = turned_strand(570, 5);
+    f.options.policy.attempts = 1;
+    const detail::RepairResult narrow = patched_with(f, &PatchPolicy::wider_rings, 0);
+    REQUIRE_FALSE(narrow.ok);
+    const detail::RepairResult wider = patched_with(f, &PatchPolicy::wider_rings, 1);
+    CHECK(wider.attempts > narrow.attempts);
+    // The first round again, then the same attempts over a region of two
+    // rings, which holds the one-ring region and more.
+    CHECK(wider.attempted_triangles > 2 * narrow.attempted_triangles);
+    if (!wider.ok) CHECK(wider.failed_because.find("with 2 rings") != std::string::npos);
+    if (wider.ok) check_patched(f, wider);
+  }
+  SECTION("a patch that succeeds is not tried again") {
+    TurnedStrand f = turned_strand(570, 2);
+    const detail::RepairResult narrow = patched_with(f, &PatchPolicy::wider_rings, 0);
+    REQUIRE(narrow.ok);
+    const detail::RepairResult wider = patched_with(f, &PatchPolicy::wider_rings, 1);
+    REQUIRE(wider.ok);
+    CHECK(wider.attempts == narrow.attempts);
+    CHECK(wider.mesh.triangles == narrow.mesh.triangles);
+  }
+  SECTION("a patch that took nearly the whole frame is not tried again") {
+    TurnedStrand f = turned_strand(500, 4);
+    f.options.policy.max_sample_share = 0.3;
+    const detail::RepairResult narrow = patched_with(f, &PatchPolicy::wider_rings, 0);
+    REQUIRE_FALSE(narrow.ok);
+    REQUIRE(narrow.failed_because.find("nearly the whole frame") != std::string::npos);
+    CHECK(patched_with(f, &PatchPolicy::wider_rings, 1).attempts == narrow.attempts);
+  }
+}

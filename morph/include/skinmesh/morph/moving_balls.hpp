@@ -93,11 +93,14 @@ struct MovingOptions {
   // succeeded or not (docs/benchmarks.md, moving atoms). A patch's second
   // attempt meshes only around the first one's faults: bench_moving's 3mht
   // DNA motion (101 frames) spent 44% less time in local patches, its
-  // frames 24% less in all; its hinge motion 3% less a frame.
+  // frames 24% less in all; its hinge motion 3% less a frame. A patch that
+  // fails is tried once more with one more ring (PatchPolicy::wider_rings)
+  // before the step is remeshed whole.
   RepairPolicy repair = [] {
     RepairPolicy r;
     r.patch.max_sample_share = 0.3;  // a share, 0-1
     r.patch.retry_around_faults = true;
+    r.patch.wider_rings = 1;
     return r;
   }();
 };

@@ -48,6 +48,12 @@ struct PatchPolicy {
   // count): one ring mends as many frames as two, at less cost, and none
   // mends fewer.
   int rings = 1;
+  // A patch that failed (other than by taking nearly the whole frame) is
+  // tried once more from the start with this many more rings (a count; 0:
+  // not), before the frame is remeshed whole. A wider region moves the
+  // seam off faults the narrow one could not grow past. Moving atoms turn
+  // it on (moving_balls.hpp).
+  int wider_rings = 0;
   // The patch grown around the seam's faults at most this many times;
   // past the fourth, not after two attempts in a row that left no fewer
   // faults than the fewest before.
