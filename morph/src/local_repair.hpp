@@ -46,6 +46,10 @@ struct LocalRepairOptions {
   // events', events.hpp). The components may change by at most one a change.
   std::vector<TopologyChange> changes;
   long euler_change = 0;
+  // The caller counts the patched mesh's components itself (MovingBalls'
+  // certificate, mesh_topology): the patch then counts them only where
+  // the topology changes, saving two passes over the whole frame.
+  bool components_certified_after = false;
 };
 
 // Skin points around the places where the topology changed, for a whole

@@ -900,6 +900,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   // of the local patch, whose Euler characteristic is checked.
   local.crowded_below = options_.repair.crowded_below;
   local.policy = options_.repair.patch;
+  local.components_certified_after = true;  // mesh_topology below
   std::vector<detail::VanishingSphere> vanished;
   if (topology != topology_) {
     topology_changes(complex_, critical_, next, critical, false, local, vanished);
