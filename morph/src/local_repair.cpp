@@ -907,6 +907,13 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
   return out;
 }
 
+// The attempt counts of `earlier` added to `later`'s.
+void add_attempts(const RepairResult& earlier, RepairResult& later) {
+  later.attempts += earlier.attempts;
+  later.context_vertices += earlier.context_vertices;
+  later.attempted_triangles += earlier.attempted_triangles;
+}
+
 Retry piecewise(const PatchPolicy& policy) { return policy.retry_around_faults ? Retry::around_faults : Retry::pieces; }
 
 // Retrying only the pieces that did not hold is cheaper, but a piece alone
@@ -924,9 +931,7 @@ RepairResult whole_context_patch(const SkinComplex& complex, const SurfaceMesh& 
                                     failure);
   if (out.ok || !failure.put_in || !failure.ran_away) return out;
   RepairResult whole = patch_attempts(complex, given, failing, repair, accept, options, Retry::whole, 0, failure);
-  whole.attempts += out.attempts;
-  whole.attempted_triangles += out.attempted_triangles;
-  whole.context_vertices += out.context_vertices;
+  add_attempts(out, whole);
   return whole;
 }
 
@@ -937,13 +942,6 @@ std::vector<SkinSample> seeds_at_changes(const SkinComplex& complex, const std::
 }
 
 namespace {
-
-// The attempt counts of `earlier` added to `later`'s.
-void add_attempts(const RepairResult& earlier, RepairResult& later) {
-  later.attempts += earlier.attempts;
-  later.context_vertices += earlier.context_vertices;
-  later.attempted_triangles += earlier.attempted_triangles;
-}
 
 // A local context first (PatchPolicy::local_context_first); when that
 // fails, the whole region's measure, unless the local patch already took
