@@ -747,11 +747,11 @@ long closed_euler(const SurfaceMesh& mesh) {
 // (Morse theory, exact: events.hpp; none without a change), so a patch
 // that grew a second layer or closed a piece off shows up here; the
 // components may change by no more than one a change (none without). When
-// the caller certifies the components after the patch, they are counted
-// here only at changes.
+// the caller certifies the components after the patch, they are not
+// counted here.
 bool topology_as_expected(const SurfaceMesh& before, const SurfaceMesh& after, const LocalRepairOptions& options) {
   if (closed_euler(after) != closed_euler(before) + options.euler_change) return false;
-  if (options.changes.empty() && options.components_certified_after) return true;
+  if (options.components_certified_after) return true;
   const long components_before = component_count(before);
   const long components_after = component_count(after);
   return std::abs(components_after - components_before) <= static_cast<long>(options.changes.size());

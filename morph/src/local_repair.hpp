@@ -47,8 +47,9 @@ struct LocalRepairOptions {
   std::vector<TopologyChange> changes;
   long euler_change = 0;
   // The caller counts the patched mesh's components itself (MovingBalls'
-  // certificate, mesh_topology): the patch then counts them only where
-  // the topology changes, saving two passes over the whole frame.
+  // certificate, mesh_topology) and remeshes when they are wrong: the patch
+  // then checks the Euler characteristic alone, saving two passes over the
+  // whole frame.
   bool components_certified_after = false;
 };
 
