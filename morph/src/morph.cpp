@@ -133,7 +133,7 @@ struct Morph::Impl {
   long next_id_ = 0;
   // Thinning contractions the edits were refused, kept for the next frame's
   // (detail::RefusedEdges in surgery.hpp).
-  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;
+  detail::RefusedEdges refused_thinning_;
   std::function<void(SurfaceMesh&, std::vector<long>&)> remesh_fault_;  // detail::inject_remesh_fault
 };
 

@@ -582,7 +582,7 @@ struct MovingBalls::Impl {
   std::vector<int> critical_;  // cells of complex_ that are critical points inside the body (moving_balls.cpp)
   MorphFrame frame_;
   long next_id_ = 0;
-  std::map<std::pair<long, long>, std::pair<double, int>> refused_thinning_;  // detail::RefusedEdges
+  detail::RefusedEdges refused_thinning_;
   std::function<void(SurfaceMesh&, std::vector<long>&)> certificate_fault_;  // tests only: none
   // The last step ended with every triangle of the frame judged passing
   // (mended locally, or nothing to mend), not remeshed: the settled

@@ -419,7 +419,10 @@ std::vector<char> Editor::near_change() const {
 void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<long>* ids, RefusedEdges* refused) {
   const size_t n = mesh_.vertices.size();
   RefusedEdges before;
-  if (refused) before.swap(*refused);
+  if (refused) {
+    before.swap(*refused);
+    refused->reserve(before.size());
+  }
   // The edge a - b by the ids of its ends; none without a memo, or for a
   // vertex a split made in this frame (its edges are new).
   auto key_of = [&](int a, int b) -> std::optional<std::pair<long, long>> {

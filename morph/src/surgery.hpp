@@ -20,7 +20,8 @@
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/morph/repair_policy.hpp"
 
-#include <map>
+#include <functional>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -28,8 +29,14 @@ namespace skinmesh::detail {
 
 // Thinning contractions refused, by the vertex ids of the edge's ends
 // (smaller first): the edge's length then and the frames since. Kept by the
-// caller from frame to frame.
-using RefusedEdges = std::map<std::pair<long, long>, std::pair<double, int>>;
+// caller from frame to frame. Hashed: every short edge near a change looks
+// itself up in every frame, and nothing walks the memo in order.
+struct EdgeIdsHash {
+  size_t operator()(const std::pair<long, long>& e) const noexcept {
+    return std::hash<long>{}(e.first) ^ (std::hash<long>{}(e.second) * 0x9e3779b97f4a7c15ULL);
+  }
+};
+using RefusedEdges = std::unordered_map<std::pair<long, long>, std::pair<double, int>, EdgeIdsHash>;
 
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
 // skin of `complex`; the others are taken to pass. With `ids` (per vertex of
