@@ -285,6 +285,7 @@ json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::stri
   j["steps_built_ahead"] = s.built_ahead;
   j["reidentified"] = s.reidentified;
   j["settled"] = s.settled;
+  j["carried"] = s.carried;
   j["ids_kept"] = s.ids_kept;
   j["max_kept_move"] = s.max_kept_move;
   return j;

@@ -214,6 +214,7 @@ nlohmann::json stats_json(const FrameStats& s) {
           {"steps_built_ahead", s.built_ahead},
           {"reidentified", s.reidentified},
           {"settled", s.settled},
+          {"carried", s.carried},
           {"ids_kept", s.ids_kept},
           {"max_kept_move", s.max_kept_move},
           {"repaired", s.repaired},

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace skinmesh::detail {
@@ -57,18 +58,72 @@ long rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
   return static_cast<long>(at.size());
 }
 
+namespace {
+
+enum class Known : char { nothing, settled, carried };
+
+// Whether the edge a - b kept its length through the step, to 1e-9 A.
+bool kept_length(const SurfaceMesh& mesh, const std::vector<Eigen::Vector3d>& before, int a, int b) {
+  const size_t i = static_cast<size_t>(a), k = static_cast<size_t>(b);
+  return std::abs((mesh.vertices[i] - mesh.vertices[k]).norm() - (before[i] - before[k]).norm()) <= 1e-9;
+}
+
+// What `known` says of triangle t (KnownVerdicts).
+Known known_of(const SurfaceMesh& mesh, const KnownVerdicts& known, const std::array<int, 3>& t) {
+  const auto marked = [&](const std::vector<char>& marks) {
+    return marks.size() == mesh.vertices.size() && marks[static_cast<size_t>(t[0])] &&
+           marks[static_cast<size_t>(t[1])] && marks[static_cast<size_t>(t[2])];
+  };
+  if (marked(known.settled)) return Known::settled;
+  if (known.carried.size() != mesh.vertices.size() || known.before.size() != mesh.vertices.size()) return Known::nothing;
+  for (int v : t) {
+    const size_t i = static_cast<size_t>(v);
+    if (!known.carried[i] && !(known.settled.size() == known.carried.size() && known.settled[i])) return Known::nothing;
+  }
+  for (size_t k = 0; k < 3; ++k)
+    if (!kept_length(mesh, known.before, t[k], t[(k + 1) % 3])) return Known::nothing;
+  return Known::carried;
+}
+
+// The verdicts of `mesh`'s triangles as `known` allows (KnownVerdicts),
+// into j.failing, j.settled and j.carried.
+void judge_known(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria,
+                 const KnownVerdicts& known, Judged& j) {
+  std::vector<Known> kinds(mesh.triangles.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, kinds.size(), 2048), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t f = r.begin(); f != r.end(); ++f) kinds[f] = known_of(mesh, known, mesh.triangles[f]);
+  });
+  std::vector<std::array<int, 3>> again;
+  std::vector<size_t> at;
+  j.failing.assign(mesh.triangles.size(), 0);
+  for (size_t f = 0; f < kinds.size(); ++f) {
+    const std::array<int, 3>& t = mesh.triangles[f];
+    if (kinds[f] == Known::settled) {
+      ++j.settled;
+    } else if (kinds[f] == Known::carried) {
+      ++j.carried;
+      j.failing[f] = !shape_passes({mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
+                                    mesh.vertices[static_cast<size_t>(t[2])]},
+                                   criteria.min_angle);
+    } else {
+      again.push_back(t);
+      at.push_back(f);
+    }
+  }
+  const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
+  for (size_t k = 0; k < at.size(); ++k) j.failing[at[k]] = verdicts[k];
+}
+
+}  // namespace
+
 Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,
-                       const MeshingOptions& criteria, const std::vector<char>* settled) {
+                       const MeshingOptions& criteria, const KnownVerdicts* known) {
   Judged j;
   auto stage = Clock::now();
-  if (settled != nullptr && settled->size() == mesh.vertices.size()) {
-    std::vector<char> unsettled(mesh.vertices.size());
-    std::transform(settled->begin(), settled->end(), unsettled.begin(), [](char s) { return static_cast<char>(!s); });
-    j.failing.assign(mesh.triangles.size(), 0);
-    j.settled = static_cast<long>(mesh.triangles.size()) - rejudge_moved(complex, mesh, unsettled, criteria, j.failing);
-  } else {
+  if (known != nullptr)
+    judge_known(complex, mesh, criteria, *known, j);
+  else
     j.failing = failing_triangles(complex, mesh, mesh.triangles, criteria);
-  }
   j.failing_before_relax = std::count(j.failing.begin(), j.failing.end(), 1);
   j.seconds_judge = seconds_since(stage);
   if (j.failing_before_relax == 0 || relaxation.passes == 0) return j;

@@ -46,22 +46,38 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
 long rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
                    const MeshingOptions& criteria, std::vector<char>& failing);
 
+// What the caller knows of a transported frame's verdicts, per vertex of
+// the mesh (an empty vector: nothing).
+struct KnownVerdicts {
+  // The vertex stayed where the step left the skin and its cells exactly
+  // as they were (two rings of atoms deep), and its triangles passed: a
+  // triangle with three such corners keeps its verdict unjudged.
+  std::vector<char> settled;
+  // The vertex moved with the skin around it as one rigid body (two rings
+  // of atoms deep, to 1e-9 A), and its triangles passed: a triangle whose
+  // corners are all settled or carried and whose edges kept their lengths
+  // (to 1e-9 A; `before`) sees a congruent skin. The skin criteria, which
+  // a congruent triangle meets as it met them, keep its verdict; its angles
+  // are judged again, so that the angle bound holds exactly.
+  std::vector<char> carried;
+  std::vector<Eigen::Vector3d> before;  // the vertices' places before the step (with `carried`)
+};
+
 // A transported frame judged, with relaxation only where it is needed (the
 // moving-balls engine, whose steps fail a few triangles where atoms meet):
-// every triangle judged, the corners of those that fail relaxed along the
-// skin (relaxation.hpp; none when options.passes is 0), and the triangles
-// those moves touched judged again. The other vertices stay on their
-// closed-form paths. A triangle whose three corners `settled` marks (per
-// vertex; empty or null: none) is taken as passing unjudged: the caller
-// knows it passed and that nothing it is judged by changed.
+// every triangle judged (as `known` allows), the corners of those that fail
+// relaxed along the skin (relaxation.hpp; none when options.passes is 0),
+// and the triangles those moves touched judged again in full. The other
+// vertices stay on their closed-form paths.
 struct Judged {
   std::vector<char> failing;       // per triangle, after the relaxation
   std::vector<char> relaxed;       // per vertex, 1 where the relaxation moved it (empty: none moved)
   long failing_before_relax = 0;   // triangles failing as transported
   long settled = 0;                // triangles taken as passing unjudged (all corners settled)
+  long carried = 0;                // triangles judged on their angles alone (KnownVerdicts::carried)
   double seconds_judge = 0, seconds_relax = 0;
 };
 Judged judge_and_relax(const SkinComplex& complex, SurfaceMesh& mesh, const RelaxationOptions& relaxation,
-                       const MeshingOptions& criteria, const std::vector<char>* settled = nullptr);
+                       const MeshingOptions& criteria, const KnownVerdicts* known = nullptr);
 
 }  // namespace skinmesh::detail

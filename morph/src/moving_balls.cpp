@@ -192,12 +192,13 @@ bool cell_of_flagged_balls(const MixedCell& cell, const std::vector<char>& flags
 }
 
 // Per vertex of a transported step, what the step before settled there:
-// `verdict` where the triangles around it keep the verdicts they had (the
-// skin around it is as it was), `thinning` where thinning would decide as
-// it did (its cell's balls and their neighbours moved as one rigid body:
-// mend_by_edits' `still`).
+// `verdict` what the judge may take from the step before (the skin around
+// the vertex as it was, or moved as one rigid body: judge.hpp), `thinning`
+// where thinning would decide as it did (its cell's balls and their
+// neighbours moved as one rigid body: mend_by_edits' `still`).
 struct Settled {
-  std::vector<char> verdict, thinning;
+  detail::KnownVerdicts verdict;
+  std::vector<char> thinning;
 };
 
 // Where a vertex was before a step, and how far it may move in the step
@@ -789,14 +790,22 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // Thinning would decide as it did where the cells around a vertex moved
   // as one rigid body: the same edge lengths, targets and fans.
   const std::vector<char> rigid_balls = rigidly_moved_balls(complex_, next.balls(), rotations);
+  // The judge's counterpart: a triangle whose corners moved with cells two
+  // rings of rigid motion deep sees a congruent skin (judge.hpp).
+  const std::vector<char> carried_balls = with_all_neighbours(complex_, next, rigid_balls);
   std::vector<char> lost(n, 0), stayed(n, 0);
-  Settled settled{std::vector<char>(n, 0), std::vector<char>(n, 0)};
+  Settled settled;
+  settled.verdict.settled.assign(n, 0);
+  settled.verdict.carried.assign(n, 0);
+  settled.verdict.before = frame_.mesh.vertices;
+  settled.thinning.assign(n, 0);
   for (size_t v = 0; v < n; ++v) {
     lost[v] = fates[v] == VertexFate::lost;
     stayed[v] = fates[v] == VertexFate::moved || fates[v] == VertexFate::kept;
-    settled.verdict[v] = all_passed_ && fates[v] == VertexFate::kept &&
-                         cell_of_flagged_balls(next.cell(moved.cells[v]), settled_balls);
-    settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(next.cell(moved.cells[v]), rigid_balls);
+    const MixedCell& cell = next.cell(moved.cells[v]);
+    settled.verdict.settled[v] = all_passed_ && fates[v] == VertexFate::kept && cell_of_flagged_balls(cell, settled_balls);
+    settled.verdict.carried[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls);
+    settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, rigid_balls);
     s.moved += stayed[v];
     s.relocated += fates[v] == VertexFate::relocated;
     s.lost += lost[v];
@@ -875,10 +884,11 @@ void MovingBalls::Impl::repair(const SkinComplex& next, const SkinTopology& topo
 // relaxed vertices are no longer `settled`.
 std::vector<char> MovingBalls::Impl::judge_and_relax(const SkinComplex& next, SurfaceMesh& moved, Settled& settled) {
   detail::Judged j = detail::judge_and_relax(next, moved, options_.relaxation, options_.frames, &settled.verdict);
-  for (size_t v = 0; v < j.relaxed.size() && v < settled.verdict.size(); ++v)
-    if (j.relaxed[v]) settled.verdict[v] = settled.thinning[v] = 0;
+  for (size_t v = 0; v < j.relaxed.size() && v < settled.thinning.size(); ++v)
+    if (j.relaxed[v]) settled.verdict.settled[v] = settled.verdict.carried[v] = settled.thinning[v] = 0;
   FrameStats& s = frame_.stats;
   s.settled += j.settled;
+  s.carried += j.carried;
   s.bad_triangles += j.failing_before_relax;
   s.seconds_judge += j.seconds_judge;
   s.seconds_relax += j.seconds_relax;
@@ -974,11 +984,14 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
   std::vector<long> ids;
   for (int v : kept_from) ids.push_back(frame_.ids[static_cast<size_t>(v)]);
   frame_.ids = std::move(ids);
-  for (std::vector<char>* marks : {&lost, &settled.verdict, &settled.thinning}) {
+  for (std::vector<char>* marks : {&lost, &settled.verdict.settled, &settled.verdict.carried, &settled.thinning}) {
     std::vector<char> kept;
     for (int v : kept_from) kept.push_back(marks->empty() ? 0 : (*marks)[static_cast<size_t>(v)]);
     *marks = std::move(kept);
   }
+  std::vector<Eigen::Vector3d> before;
+  for (int v : kept_from) before.push_back(settled.verdict.before[static_cast<size_t>(v)]);
+  settled.verdict.before = std::move(before);
   euler_change += 2 * static_cast<long>(vanished.size());
   return true;
 }

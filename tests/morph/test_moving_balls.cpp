@@ -184,6 +184,66 @@ TEST_CASE("moving balls: a rigid rotation turns every vertex with the molecule",
       worst = std::max(worst, (f.mesh.vertices[v] - (centre + turn * (first.vertices[v] - centre))).norm());
     CHECK(worst < 1e-8);
     CHECK(f.stats.ids_kept == 1.0);
+    // Every ball moved with its neighbours as one rigid body: from the
+    // second frame on (the first follows a mesh made at other criteria) no
+    // triangle is judged on the skin again, and judged again in full, by the
+    // same judge against the frame's own complex, every one passes.
+    if (k > 1) CHECK(f.stats.carried == f.stats.triangles);
+    const std::vector<char> failing =
+        detail::failing_triangles(moving.complex(), f.mesh, f.mesh.triangles, one_step.frames);
+    CHECK(std::count(failing.begin(), failing.end(), 1) == 0);
+  }
+}
+
+TEST_CASE("judging: a triangle carried rigidly keeps its skin verdicts and has its angles judged again", "[moving]") {
+  const std::vector<Ball> balls = molecule_balls("pept.pdb");
+  const SkinComplex complex = build_skin_complex(balls, {0.5});
+  const MeshingOptions criteria = MovingOptions{}.frames;
+  SkinMeshResult made = mesh_skin(complex, criteria);
+  REQUIRE(made.status == MeshingStatus::ok);
+  SurfaceMesh mesh = made.mesh;
+  RelaxationOptions none;
+  none.passes = 0;  // the verdicts as judged, nothing moved
+  const long triangles = static_cast<long>(mesh.triangles.size());
+  // Squash the triangles around vertex 0: moved most of the way to a neighbour.
+  const int a = mesh.triangles[0][0], b = mesh.triangles[0][1];
+  const std::vector<Eigen::Vector3d> unsquashed = mesh.vertices;
+  mesh.vertices[static_cast<size_t>(a)] += 0.9 * (mesh.vertices[static_cast<size_t>(b)] - mesh.vertices[static_cast<size_t>(a)]);
+  long star = 0, bad_shape = 0;
+  for (const auto& t : mesh.triangles) {
+    star += t[0] == a || t[1] == a || t[2] == a;
+    bad_shape += !shape_passes({mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
+                                mesh.vertices[static_cast<size_t>(t[2])]},
+                               criteria.min_angle);
+  }
+  REQUIRE(bad_shape > 0);
+  detail::KnownVerdicts known;
+  known.carried.assign(mesh.vertices.size(), 1);
+  SECTION("told every edge kept its length, the judge still finds every triangle of bad angles") {
+    known.before = mesh.vertices;
+    SurfaceMesh judged = mesh;
+    const detail::Judged j = detail::judge_and_relax(complex, judged, none, criteria, &known);
+    CHECK(j.carried == triangles);
+    long caught = 0;
+    for (size_t f = 0; f < judged.triangles.size(); ++f) {
+      const auto& t = judged.triangles[f];
+      const bool bad = !shape_passes({judged.vertices[static_cast<size_t>(t[0])], judged.vertices[static_cast<size_t>(t[1])],
+                                      judged.vertices[static_cast<size_t>(t[2])]},
+                                     criteria.min_angle);
+      caught += bad && j.failing[f];
+    }
+    CHECK(caught == bad_shape);
+  }
+  SECTION("the triangles whose edges changed length are judged in full") {
+    known.before = unsquashed;
+    SurfaceMesh judged = mesh;
+    const detail::Judged j = detail::judge_and_relax(complex, judged, none, criteria, &known);
+    CHECK(j.carried == triangles - star);
+    const std::vector<char> full = detail::failing_triangles(complex, mesh, mesh.triangles, criteria);
+    for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+      const auto& t = mesh.triangles[f];
+      if (t[0] == a || t[1] == a || t[2] == a) CHECK(j.failing[f] == full[f]);
+    }
   }
 }
 

@@ -114,6 +114,7 @@ struct FrameStats {
   long built_ahead = 0;        // of them, whose complex was built beside the step before's repair
   long reidentified = 0;       // vertices that moved farther than continuity allows and took a new id
   long settled = 0;            // triangles in skin the step left as it was, kept as passing unjudged
+  long carried = 0;            // triangles in skin the step moved as one rigid body: angles judged again, the rest kept
   double ids_kept = 0;         // share of the frame's vertices whose id the frame before had
   double max_kept_move = 0;    // largest move of a vertex whose id was kept, since the frame before (Angstrom)
   bool topology_certified = false;  // components, voids and Euler characteristic equal the skin's (skin_topology)
