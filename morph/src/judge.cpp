@@ -40,21 +40,31 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
   return bad;
 }
 
+namespace {
+
+// The triangles of `mesh` numbered in `at` judged, their verdicts into `failing`.
+void judge_these(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<size_t>& at,
+                 const MeshingOptions& criteria, std::vector<char>& failing) {
+  std::vector<std::array<int, 3>> again;
+  again.reserve(at.size());
+  for (size_t f : at) again.push_back(mesh.triangles[f]);
+  const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
+  for (size_t k = 0; k < at.size(); ++k) failing[at[k]] = verdicts[k];
+}
+
+}  // namespace
+
 long rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& moved,
                    const MeshingOptions& criteria, std::vector<char>& failing) {
   if (failing.size() != mesh.triangles.size() || moved.size() != mesh.vertices.size())
     contract_error("rejudge_moved: verdicts or marks do not match the mesh");
-  std::vector<std::array<int, 3>> again;
   std::vector<size_t> at;
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {
     const std::array<int, 3>& t = mesh.triangles[f];
-    if (moved[static_cast<size_t>(t[0])] || moved[static_cast<size_t>(t[1])] || moved[static_cast<size_t>(t[2])]) {
-      again.push_back(t);
+    if (moved[static_cast<size_t>(t[0])] || moved[static_cast<size_t>(t[1])] || moved[static_cast<size_t>(t[2])])
       at.push_back(f);
-    }
   }
-  const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
-  for (size_t k = 0; k < at.size(); ++k) failing[at[k]] = verdicts[k];
+  judge_these(complex, mesh, at, criteria, failing);
   return static_cast<long>(at.size());
 }
 
@@ -93,7 +103,6 @@ void judge_known(const SkinComplex& complex, const SurfaceMesh& mesh, const Mesh
   tbb::parallel_for(tbb::blocked_range<size_t>(0, kinds.size(), 2048), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t f = r.begin(); f != r.end(); ++f) kinds[f] = known_of(mesh, known, mesh.triangles[f]);
   });
-  std::vector<std::array<int, 3>> again;
   std::vector<size_t> at;
   j.failing.assign(mesh.triangles.size(), 0);
   for (size_t f = 0; f < kinds.size(); ++f) {
@@ -106,12 +115,10 @@ void judge_known(const SkinComplex& complex, const SurfaceMesh& mesh, const Mesh
                                     mesh.vertices[static_cast<size_t>(t[2])]},
                                    criteria.min_angle);
     } else {
-      again.push_back(t);
       at.push_back(f);
     }
   }
-  const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
-  for (size_t k = 0; k < at.size(); ++k) j.failing[at[k]] = verdicts[k];
+  judge_these(complex, mesh, at, criteria, j.failing);
 }
 
 }  // namespace

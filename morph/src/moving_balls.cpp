@@ -797,7 +797,6 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   Settled settled;
   settled.verdict.settled.assign(n, 0);
   settled.verdict.carried.assign(n, 0);
-  settled.verdict.before = frame_.mesh.vertices;
   settled.thinning.assign(n, 0);
   for (size_t v = 0; v < n; ++v) {
     lost[v] = fates[v] == VertexFate::lost;
@@ -810,6 +809,9 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
     s.relocated += fates[v] == VertexFate::relocated;
     s.lost += lost[v];
   }
+  // The places before the step only where a vertex is carried (KnownVerdicts::before).
+  if (std::find(settled.verdict.carried.begin(), settled.verdict.carried.end(), 1) != settled.verdict.carried.end())
+    settled.verdict.before = frame_.mesh.vertices;
   const std::vector<int> index_before = vertex_of_id(frame_.ids, next_id_);  // a vertex id -> its index in `reach`
   s.seconds_transport += seconds_since(stage);
   stage = Clock::now();
@@ -989,9 +991,11 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
     for (int v : kept_from) kept.push_back(marks->empty() ? 0 : (*marks)[static_cast<size_t>(v)]);
     *marks = std::move(kept);
   }
-  std::vector<Eigen::Vector3d> before;
-  for (int v : kept_from) before.push_back(settled.verdict.before[static_cast<size_t>(v)]);
-  settled.verdict.before = std::move(before);
+  if (!settled.verdict.before.empty()) {
+    std::vector<Eigen::Vector3d> before;
+    for (int v : kept_from) before.push_back(settled.verdict.before[static_cast<size_t>(v)]);
+    settled.verdict.before = std::move(before);
+  }
   euler_change += 2 * static_cast<long>(vanished.size());
   return true;
 }
