@@ -209,10 +209,11 @@ std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vect
 // reach of the whole. Local (`local_scale` > 0): at each patch vertex the
 // longest region edge within two rings of it, times `local_scale`; the
 // refinement is then held near the patch (mesh_patch's `within`: half the
-// reach at each vertex), where this context covers the skin. `reach` gets
-// the distance per vertex. Returns the largest measure.
+// reach at each vertex), where this context covers the skin; the reach is
+// at most `local_reach_cap` (PatchPolicy, > 0) times `local_scale` target
+// lengths. `reach` gets the distance per vertex. Returns the largest measure.
 double add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
-                   const std::vector<char>& region, double at_least, double local_scale,
+                   const std::vector<char>& region, double at_least, double local_scale, double local_reach_cap,
                    const MeshingOptions& criteria, std::vector<signed char>& role, std::vector<double>& reach) {
   constexpr double kLargeShare = 0.25;       // of the frame's vertices
   constexpr double kCapInTargetLengths = 6;  // dimensionless
@@ -234,10 +235,12 @@ double add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const Ve
   }
   const std::vector<signed char> patch = role;
   const auto large = static_cast<size_t>(kLargeShare * static_cast<double>(role.size()));
-  if (add_nearby_context(complex, mesh, stars, longest, criteria, std::numeric_limits<double>::infinity(), large,
-                         role, reach))
+  // The local measure's cap grows with it (a stalled patch is tried again reaching farther).
+  const double first_cap = local_scale > 0 && local_reach_cap > 0 ? local_scale * local_reach_cap
+                                                                 : std::numeric_limits<double>::infinity();
+  if (add_nearby_context(complex, mesh, stars, longest, criteria, first_cap, large, role, reach))
     return measure;
-  role = patch;  // the uncapped search stopped once it passed a quarter
+  role = patch;  // the first search stopped once it passed a quarter
   add_nearby_context(complex, mesh, stars, longest, criteria, kCapInTargetLengths, SIZE_MAX, role, reach);
   return measure;
 }
@@ -492,7 +495,8 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
     if (stars.empty(static_cast<int>(v))) role[v] = static_cast<signed char>(PatchRole::interior);
   std::vector<double> reach;
   a.reach_measure =
-      add_context(complex, mesh, stars, region, so_far.reach_measure, so_far.local_scale, accept, role, reach);
+      add_context(complex, mesh, stars, region, so_far.reach_measure, so_far.local_scale,
+                  options.policy.local_reach_cap, accept, role, reach);
   const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, options.crowded_below);
   std::vector<PatchRole> roles;
   std::vector<int> index;

@@ -308,6 +308,24 @@ TEST_CASE("local repair: a patch first takes a context near each of its vertices
   check_patched(f, local);
 }
 
+TEST_CASE("local repair: the local context reaches at most local_reach_cap target lengths", "[morph]") {
+  // The strand's last 53 atoms turned by 3 degrees: transport stretches
+  // region triangles to more than six target lengths, and twice such an
+  // edge sets the uncapped reach at the vertices near them. Capped, the
+  // patch takes fewer context vertices and still makes a frame that holds
+  // the guarantees.
+  TurnedStrand f = turned_strand(540, 3);
+  f.options.policy.retry_around_faults = true;
+  const detail::RepairResult uncapped = patched_with(f, &PatchPolicy::local_reach_cap, 0.0);
+  const detail::RepairResult capped = patched_with(f, &PatchPolicy::local_reach_cap, 6.0);
+  REQUIRE(uncapped.ok);
+  REQUIRE(capped.ok);
+  INFO("context vertices: capped " << capped.context_vertices << " over " << capped.attempts << " attempts, uncapped "
+                                   << uncapped.context_vertices << " over " << uncapped.attempts);
+  CHECK(capped.context_vertices * uncapped.attempts < uncapped.context_vertices * capped.attempts);
+  check_patched(f, capped);
+}
+
 TEST_CASE("local repair: a patch that fails is tried once more from the start with wider_rings more rings", "[morph]") {
   SECTION("allowed one attempt a round, the patch fails, and its second round meshes a wider region") {
     // The strand's last 32 atoms turned by 5 degrees need more than one

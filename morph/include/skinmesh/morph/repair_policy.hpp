@@ -106,6 +106,13 @@ struct PatchPolicy {
   // A region with one stretched triangle otherwise takes a context of tens
   // of thousands of vertices for a few hundred of its own.
   bool local_context_first = true;
+  // The local context's reach (above) at a patch vertex is at most this
+  // many target edge lengths there (dimensionless; 0: no cap). A region
+  // triangle that transport stretched across a topology change otherwise
+  // sets a reach of several Angstrom for every vertex within two rings of
+  // it, and the context then holds thousands of vertices far from where
+  // anything is meshed. Moving atoms take 6 (moving_balls.hpp).
+  double local_reach_cap = 0;
 };
 
 struct RepairPolicy {
