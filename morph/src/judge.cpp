@@ -86,10 +86,8 @@ Known known_of(const SurfaceMesh& mesh, const KnownVerdicts& known, const std::a
   };
   if (marked(known.settled)) return Known::settled;
   if (known.carried.size() != mesh.vertices.size() || known.before.size() != mesh.vertices.size()) return Known::nothing;
-  for (int v : t) {
-    const size_t i = static_cast<size_t>(v);
-    if (!known.carried[i] && !(known.settled.size() == known.carried.size() && known.settled[i])) return Known::nothing;
-  }
+  for (int v : t)
+    if (!known.carried[static_cast<size_t>(v)]) return Known::nothing;
   for (size_t k = 0; k < 3; ++k)
     if (!kept_length(mesh, known.before, t[k], t[(k + 1) % 3])) return Known::nothing;
   return Known::carried;

@@ -49,16 +49,20 @@ long rejudge_moved(const SkinComplex& complex, const SurfaceMesh& mesh, const st
 // What the caller knows of a transported frame's verdicts, per vertex of
 // the mesh (an empty vector: nothing).
 struct KnownVerdicts {
-  // The vertex stayed where the step left the skin and its cells exactly
-  // as they were (two rings of atoms deep), and its triangles passed: a
-  // triangle with three such corners keeps its verdict unjudged.
+  // The vertex did not move, its triangles passed, and the skin within
+  // the judge's reach of them is the function it was: the step left the
+  // skin and its cells exactly as they were two rings of atoms deep, or no
+  // atom that moved is active there before the step or after it
+  // (skin_unchanged_near). A triangle with three such corners keeps its
+  // verdict unjudged.
   std::vector<char> settled;
   // The vertex moved with the skin around it as one rigid body (two rings
-  // of atoms deep, to 1e-9 A), and its triangles passed: a triangle whose
-  // corners are all settled or carried and whose edges kept their lengths
-  // (to 1e-9 A; `before`) sees a congruent skin. The skin criteria, which
-  // a congruent triangle meets as it met them, keep its verdict; its angles
-  // are judged again, so that the angle bound holds exactly.
+  // of atoms deep, to 1e-9 A; a vertex settled by two rings of still atoms
+  // moved by none), and its triangles passed: a triangle whose corners are
+  // all carried and whose edges kept their lengths (to 1e-9 A; `before`)
+  // sees a congruent skin. The skin criteria, which a congruent triangle
+  // meets as it met them, keep its verdict; its angles are judged again, so
+  // that the angle bound holds exactly.
   std::vector<char> carried;
   std::vector<Eigen::Vector3d> before;  // the vertices' places before the step (with `carried`)
 };

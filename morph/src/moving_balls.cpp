@@ -7,6 +7,7 @@
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
 #include "surgery.hpp"
+#include "unchanged_skin.hpp"
 #include "vanishing.hpp"
 
 #include <Eigen/Dense>
@@ -126,6 +127,9 @@ Eigen::Matrix3d cell_rotation(const MixedCell& cell, const std::vector<Ball>& ol
 
 // kept: in a cell the step left as it was (quiet_balls), where it stays.
 enum class VertexFate : char { kept, moved, relocated, lost };
+
+// Whether the vertex stayed on its cell's closed-form path (not placed again, not lost).
+bool stayed_put(VertexFate f) { return f == VertexFate::kept || f == VertexFate::moved; }
 
 // Per ball, 1 where `flags` marks it and every neighbour it has in the
 // regular triangulation of `from` or of `to` (hidden: none).
@@ -794,16 +798,35 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // rings of rigid motion deep sees a congruent skin (judge.hpp).
   const std::vector<char> carried_balls = with_all_neighbours(complex_, next, rigid_balls);
   std::vector<char> lost(n, 0), stayed(n, 0);
+  // A vertex that stayed where the skin within the judge's reach of it is
+  // proven the same function (skin_unchanged_near) is settled as well:
+  // atoms that moved nearby but stay inactive there do not unsettle it.
+  std::vector<char> unproven(n, 0);  // stayed exactly where it was, not settled by its rings
+  if (all_passed_)
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t v = r.begin(); v != r.end(); ++v)
+        unproven[v] = stayed_put(fates[v]) && moved.vertices[v] == frame_.mesh.vertices[v] &&
+                      !(fates[v] == VertexFate::kept && cell_of_flagged_balls(next.cell(moved.cells[v]), settled_balls));
+    });
+  const std::vector<char> unchanged =
+      std::find(unproven.begin(), unproven.end(), 1) == unproven.end()
+          ? unproven
+          : detail::skin_unchanged_near(complex_, next.balls(), frame_.mesh,
+                                        detail::judged_reach(frame_.mesh, options_.frames.tolerance, unproven),
+                                        unproven);
   Settled settled;
   settled.verdict.settled.assign(n, 0);
   settled.verdict.carried.assign(n, 0);
   settled.thinning.assign(n, 0);
   for (size_t v = 0; v < n; ++v) {
     lost[v] = fates[v] == VertexFate::lost;
-    stayed[v] = fates[v] == VertexFate::moved || fates[v] == VertexFate::kept;
+    stayed[v] = stayed_put(fates[v]);
     const MixedCell& cell = next.cell(moved.cells[v]);
-    settled.verdict.settled[v] = all_passed_ && fates[v] == VertexFate::kept && cell_of_flagged_balls(cell, settled_balls);
-    settled.verdict.carried[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls);
+    const bool ring_settled =
+        all_passed_ && fates[v] == VertexFate::kept && cell_of_flagged_balls(cell, settled_balls);
+    settled.verdict.settled[v] = ring_settled || unchanged[v];
+    // A vertex settled by its rings of still atoms is carried (by no motion) too.
+    settled.verdict.carried[v] = ring_settled || (all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls));
     settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, rigid_balls);
     s.moved += stayed[v];
     s.relocated += fates[v] == VertexFate::relocated;

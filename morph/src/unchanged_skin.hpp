@@ -1,0 +1,31 @@
+// Where a step of moving balls leaves the skin the same function (private
+// to morph/): the judge keeps the verdict of a triangle whose corners did
+// not move and around which nothing the judge reads changed.
+#pragma once
+
+#include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/surface_mesh.hpp"
+
+#include <vector>
+
+namespace skinmesh::detail {
+
+// Per vertex of `mesh` marked in `marked`, the radius (Angstrom) of a
+// ball about it that holds everything the frame judge reads for each
+// triangle around it: the segment of the triangle's normal line through
+// its circumcentre within min(tolerance, circumradius) of it
+// (restricted_triangle); infinite next to a degenerate triangle. 0 for a
+// vertex not marked or no triangle uses.
+std::vector<double> judged_reach(const SurfaceMesh& mesh, double tolerance, const std::vector<char>& marked);
+
+// Per vertex of `mesh` marked in `candidates`, 1 where the skin of `from`
+// and of the balls `to` (the same balls after a step: same count, each
+// moved or not) is the same function, with the same mixed cells, within
+// radius[v] of the vertex; 0 where that is not proven. MATH.md section 2:
+// F is the value of a convex QP over the simplex, and a ball that moved is
+// inactive wherever its KKT slack against the optimum over the balls that
+// stayed is positive, at its place before the step and after it.
+std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector<Ball>& to, const SurfaceMesh& mesh,
+                                      const std::vector<double>& radius, const std::vector<char>& candidates);
+
+}  // namespace skinmesh::detail
