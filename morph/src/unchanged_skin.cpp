@@ -202,9 +202,12 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
     return unchanged;
   }
   constexpr double kOffSkin = 1e-9;  // slack for a vertex a little off the skin (it is within 1e-12 A)
-  constexpr double kCell = 2.0;      // Angstrom
+  constexpr double kCell = 2.0;      // Angstrom, where the places span at most kMostCellsAcross of them
+  constexpr double kMostCellsAcross = 160;  // memory stays bounded however far apart the atoms are
   const double g_most = std::sqrt(std::max((s * heaviest_of_all + kOffSkin) / (1 - s), 0.0)) + kOffSkin;
-  const PlaceGrid grid(places, kCell);
+  Eigen::AlignedBox3d span;
+  for (const Place& p : places) span.extend(p.center);
+  const PlaceGrid grid(places, std::max(kCell, span.sizes().maxCoeff() / kMostCellsAcross));
   tbb::parallel_for(tbb::blocked_range<size_t>(0, unchanged.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       if (!candidates[v] || !std::isfinite(radius[v])) continue;
