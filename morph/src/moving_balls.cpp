@@ -818,6 +818,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   settled.verdict.settled.assign(n, 0);
   settled.verdict.carried.assign(n, 0);
   settled.thinning.assign(n, 0);
+  bool carried_by_motion = false;
   for (size_t v = 0; v < n; ++v) {
     lost[v] = fates[v] == VertexFate::lost;
     stayed[v] = stayed_put(fates[v]);
@@ -826,15 +827,17 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
         all_passed_ && fates[v] == VertexFate::kept && cell_of_flagged_balls(cell, settled_balls);
     settled.verdict.settled[v] = ring_settled || unchanged[v];
     // A vertex settled by its rings of still atoms is carried (by no motion) too.
-    settled.verdict.carried[v] = ring_settled || (all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls));
+    const bool carried = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls);
+    settled.verdict.carried[v] = ring_settled || carried;
+    carried_by_motion = carried_by_motion || (carried && !ring_settled);
     settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, rigid_balls);
     s.moved += stayed[v];
     s.relocated += fates[v] == VertexFate::relocated;
     s.lost += lost[v];
   }
-  // The places before the step only where a vertex is carried (KnownVerdicts::before).
-  if (std::find(settled.verdict.carried.begin(), settled.verdict.carried.end(), 1) != settled.verdict.carried.end())
-    settled.verdict.before = frame_.mesh.vertices;
+  // The places before the step only where a vertex is carried by a motion
+  // (KnownVerdicts::before): a triangle of ring-settled corners alone is settled.
+  if (carried_by_motion) settled.verdict.before = frame_.mesh.vertices;
   const std::vector<int> index_before = vertex_of_id(frame_.ids, next_id_);  // a vertex id -> its index in `reach`
   s.seconds_transport += seconds_since(stage);
   stage = Clock::now();

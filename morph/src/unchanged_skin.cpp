@@ -34,12 +34,14 @@ std::vector<double> judged_reach(const SurfaceMesh& mesh, double tolerance, cons
         continue;
       }
       const double radius = ((u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)) / (2.0 * cross2)).norm();
-      per_triangle[f] = radius + std::min(tolerance, radius);  // the circumcentre is `radius` from every corner
+      // The circumcentre is `radius` from every corner.
+      per_triangle[f] = std::isfinite(radius) ? radius + std::min(tolerance, radius)
+                                              : std::numeric_limits<double>::infinity();
     }
   });
   std::vector<double> reach(mesh.vertices.size(), 0.0);
   for (size_t f = 0; f < per_triangle.size(); ++f)
-    if (per_triangle[f] > 0)
+    if (per_triangle[f] != 0)
       for (int v : mesh.triangles[f])
         if (marked[static_cast<size_t>(v)]) reach[static_cast<size_t>(v)] = std::max(reach[static_cast<size_t>(v)], per_triangle[f]);
   return reach;
@@ -54,14 +56,15 @@ struct Place {
 };
 
 // The smallest distance d from x0 beyond which a place of weight at most
-// `weight` is proven inactive everywhere within rho of x0 (the bound in
-// skin_unchanged_near), whatever its distance e from y: the larger root of
-//   s d^2 - 2 (rho + (1-s) a) d - ((1-s) a^2 + s w + f0 + 2 g rho) = 0,
+// `weight` is proven inactive everywhere within rho of x0, by `margin`
+// (the bound in skin_unchanged_near), whatever its distance e from y: the
+// larger root of
+//   s d^2 - 2 (rho + (1-s) a) d - ((1-s) a^2 + s w + f0 + 2 g rho + margin) = 0,
 // a = g + rho / (1-s), from e <= d + g; at least rho.
-double inactive_beyond(double s, double rho, double g, double weight, double f0) {
+double inactive_beyond(double s, double rho, double g, double weight, double f0, double margin) {
   const double a = g + rho / (1 - s);
   const double half_b = rho + (1 - s) * a;
-  const double c = (1 - s) * a * a + s * weight + std::max(f0, 0.0) + 2 * g * rho;
+  const double c = (1 - s) * a * a + s * weight + std::max(f0, 0.0) + 2 * g * rho + margin;
   return std::max(rho, (half_b + std::sqrt(half_b * half_b + s * c)) / s);
 }
 
@@ -105,15 +108,14 @@ class PlaceGrid {
     return cells_met(x, r, lo, hi) && count(lo, hi) > 0;
   }
   // Calls visit(place index) for the places in the cells the cube meets,
-  // until it returns true; returns whether it did. Rows of cells without a
-  // place are passed over by their count.
+  // until it returns true; returns whether it did. A row of cells holds
+  // its places in one run.
   template <class Visit>
   bool any_of(const Eigen::Vector3d& x, double r, Visit visit) const {
     Eigen::Vector3i lo, hi;
     if (!cells_met(x, r, lo, hi)) return false;
     for (int i = lo[0]; i <= hi[0]; ++i)
       for (int j = lo[1]; j <= hi[1]; ++j) {
-        if (count({i, j, lo[2]}, {i, j, hi[2]}) == 0) continue;
         for (int m = first_[index({i, j, lo[2]})], end = first_[index({i, j, hi[2]}) + 1]; m < end; ++m)
           if (visit(items_[static_cast<size_t>(m)])) return true;
       }
@@ -202,8 +204,8 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
     return unchanged;
   }
   constexpr double kOffSkin = 1e-9;  // slack for a vertex a little off the skin (it is within 1e-12 A)
-  constexpr double kCell = 2.0;      // Angstrom, where the places span at most kMostCellsAcross of them
-  constexpr double kMostCellsAcross = 160;  // memory stays bounded however far apart the atoms are
+  constexpr double kCell = 2.0;      // Angstrom, where the places span at most kMostCellsAcross cells
+  constexpr double kMostCellsAcross = 96;  // memory stays bounded however far apart the atoms are
   const double g_most = std::sqrt(std::max((s * heaviest_of_all + kOffSkin) / (1 - s), 0.0)) + kOffSkin;
   Eigen::AlignedBox3d span;
   for (const Place& p : places) span.extend(p.center);
@@ -214,7 +216,7 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
       const Eigen::Vector3d& x0 = mesh.vertices[v];
       const double rho = radius[v];
       // No place within the bound's reach for the most g can be: no need to evaluate F.
-      if (!grid.any_within(x0, inactive_beyond(s, rho, g_most, heaviest, kOffSkin))) {
+      if (!grid.any_within(x0, inactive_beyond(s, rho, g_most, heaviest, kOffSkin, kOffSkin))) {
         unchanged[v] = 1;
         continue;
       }
@@ -222,7 +224,8 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
       const Eigen::Vector3d y = x0 - 0.5 * e.gradient;
       const double grad = e.gradient.norm();
       const double lost = std::max(e.value, 0.0) + grad * rho + rho * rho;
-      const double reach = inactive_beyond(s, rho, 0.5 * grad, heaviest, e.value);
+      const double reach = inactive_beyond(s, rho, 0.5 * grad, heaviest, e.value, kOffSkin);
+      if (!std::isfinite(reach)) continue;  // unproven
       unchanged[v] = !grid.any_of(x0, reach, [&](int k) {
         const Place& p = places[static_cast<size_t>(k)];
         const double d = (p.center - x0).norm();

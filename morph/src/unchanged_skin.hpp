@@ -24,7 +24,12 @@ std::vector<double> judged_reach(const SurfaceMesh& mesh, double tolerance, cons
 // radius[v] of the vertex; 0 where that is not proven. MATH.md section 2:
 // F is the value of a convex QP over the simplex, and a ball that moved is
 // inactive wherever its KKT slack against the optimum over the balls that
-// stayed is positive, at its place before the step and after it.
+// stayed is positive, at its place before the step and after it. The
+// vertices must lie on the skin of `from` to 1e-9 Angstrom^2 in F (the
+// engine's lie within 1e-12 A); what is proven is the function and its
+// mixed cells, so a judge that locates a cell within its tolerances of a
+// boundary between two cells of atoms that stayed may still pick the
+// other one.
 std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector<Ball>& to, const SurfaceMesh& mesh,
                                       const std::vector<double>& radius, const std::vector<char>& candidates);
 
