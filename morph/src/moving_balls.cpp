@@ -189,10 +189,55 @@ std::vector<char> rigidly_moved_balls(const SkinComplex& from, const std::vector
   return rigid;
 }
 
+// The rigid motion that carried the most balls that moved in the step (to
+// 1e-9 A, radii kept), from the neighbourhood rotation of each of the first
+// few balls of `rigid` that moved and no motion tried before carried; none
+// when no ball that moved did so rigidly.
+std::optional<detail::RigidMotion> largest_rigid_motion(const std::vector<Ball>& old, const std::vector<Ball>& now,
+                                                        const std::vector<char>& rigid,
+                                                        const std::vector<Eigen::Matrix3d>& rotations) {
+  constexpr int kMotionsTried = 4;
+  std::optional<detail::RigidMotion> best;
+  long most = 0;
+  std::vector<char> carried(old.size(), 0);  // by a motion tried
+  int tried = 0;
+  for (size_t b = 0; b < old.size() && tried < kMotionsTried; ++b) {
+    if (!rigid[b] || carried[b] || old[b].center == now[b].center) continue;
+    ++tried;
+    const detail::RigidMotion motion{rotations[b], now[b].center - rotations[b] * old[b].center};
+    long count = 0;
+    for (size_t k = 0; k < old.size(); ++k)
+      if (old[k].weight == now[k].weight && (motion(old[k].center) - now[k].center).norm() <= 1e-9) {
+        ++count;
+        carried[k] = 1;
+      }
+    if (count > most) {
+      best = motion;
+      most = count;
+    }
+  }
+  return best;
+}
+
 bool cell_of_flagged_balls(const MixedCell& cell, const std::vector<char>& flags) {
   for (int i = 0; i <= cell.dim; ++i)
     if (!flags[static_cast<size_t>(cell.balls[static_cast<size_t>(i)])]) return false;
   return true;
+}
+
+// Per vertex of `moved` (the transported `before`), whether it stayed on its
+// cell's path and moved by `motion` (to 1e-9 A), in a cell not all of whose
+// balls are `carried_balls` (those vertices are carried by their rings).
+std::vector<char> moved_by(const detail::RigidMotion& motion, const SkinComplex& next, const SurfaceMesh& before,
+                           const SurfaceMesh& moved, const std::vector<VertexFate>& fates,
+                           const std::vector<char>& carried_balls) {
+  std::vector<char> out(moved.vertices.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      out[v] = stayed_put(fates[v]) && !cell_of_flagged_balls(next.cell(moved.cells[v]), carried_balls) &&
+               (motion(before.vertices[v]) - moved.vertices[v]).norm() <= 1e-9;
+  });
+  return out;
 }
 
 // Per vertex of a transported step, what the step before settled there:
@@ -808,12 +853,26 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
         unproven[v] = stayed_put(fates[v]) && moved.vertices[v] == frame_.mesh.vertices[v] &&
                       !(fates[v] == VertexFate::kept && cell_of_flagged_balls(next.cell(moved.cells[v]), settled_balls));
     });
+  // A vertex the step's largest rigid motion carried, not carried by its
+  // rings, whose skin within the judge's reach that motion carried as well
+  // (balls_moving_with) is carried though atoms nearby moved otherwise.
+  const std::optional<detail::RigidMotion> motion =
+      all_passed_ ? largest_rigid_motion(complex_.balls(), next.balls(), rigid_balls, rotations) : std::nullopt;
+  const std::vector<char> unproven_carried =
+      motion ? moved_by(*motion, next, frame_.mesh, moved, fates, carried_balls) : std::vector<char>(n, 0);
+  const bool any_unproven = std::find(unproven.begin(), unproven.end(), 1) != unproven.end();
+  const bool any_carried = std::find(unproven_carried.begin(), unproven_carried.end(), 1) != unproven_carried.end();
+  std::vector<char> either(n, 0);
+  for (size_t v = 0; v < n; ++v) either[v] = unproven[v] || unproven_carried[v];
+  const std::vector<double> reach_judged =
+      any_unproven || any_carried ? detail::judged_reach(frame_.mesh, options_.frames.tolerance, either)
+                                  : std::vector<double>(n, 0.0);
   const std::vector<char> unchanged =
-      std::find(unproven.begin(), unproven.end(), 1) == unproven.end()
-          ? unproven
-          : detail::skin_unchanged_near(complex_, next.balls(), frame_.mesh,
-                                        detail::judged_reach(frame_.mesh, options_.frames.tolerance, unproven),
-                                        unproven);
+      any_unproven ? detail::skin_unchanged_near(complex_, next.balls(), frame_.mesh, reach_judged, unproven) : unproven;
+  const std::vector<char> carried_along =
+      any_carried ? detail::skin_unchanged_near(complex_, detail::balls_moving_with(*motion, complex_.balls(), next.balls()),
+                                                frame_.mesh, reach_judged, unproven_carried)
+                  : unproven_carried;
   Settled settled;
   settled.verdict.settled.assign(n, 0);
   settled.verdict.carried.assign(n, 0);
@@ -828,8 +887,8 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
     settled.verdict.settled[v] = ring_settled || unchanged[v];
     // A vertex settled by its rings of still atoms is carried (by no motion) too.
     const bool carried = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls);
-    settled.verdict.carried[v] = ring_settled || carried;
-    carried_by_motion = carried_by_motion || (carried && !ring_settled);
+    settled.verdict.carried[v] = ring_settled || carried || carried_along[v];
+    carried_by_motion = carried_by_motion || ((carried || carried_along[v]) && !ring_settled);
     settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, rigid_balls);
     s.moved += stayed[v];
     s.relocated += fates[v] == VertexFate::relocated;

@@ -33,4 +33,22 @@ std::vector<double> judged_reach(const SurfaceMesh& mesh, double tolerance, cons
 std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector<Ball>& to, const SurfaceMesh& mesh,
                                       const std::vector<double>& radius, const std::vector<char>& candidates);
 
+// A rigid motion: x -> rotation x + translation (Angstrom).
+struct RigidMotion {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d operator()(const Eigen::Vector3d& x) const { return rotation * x + translation; }
+};
+
+// The balls after a step (`after`) as seen by one who moved with `motion`:
+// a ball that `motion` carried (to 1e-9 A, its weight kept) at its place
+// before the step, bit for bit; every other one taken back by the motion's
+// inverse. Where skin_unchanged_near(from, these, ...) proves the skin of
+// `from` unchanged near a vertex x, the skin after the step is that skin
+// moved by `motion`: F after at motion(x) is F before at x, with the
+// same mixed cells moved, so a triangle carried by `motion` sees a
+// congruent skin within the judge's reach.
+std::vector<Ball> balls_moving_with(const RigidMotion& motion, const std::vector<Ball>& before,
+                                    const std::vector<Ball>& after);
+
 }  // namespace skinmesh::detail

@@ -400,6 +400,71 @@ TEST_CASE("skin_unchanged_near: where it proves the skin unchanged, the oracle f
   CHECK(proven < static_cast<long>(mesh.vertices.size()));
 }
 
+TEST_CASE("balls_moving_with: where the skin is proven carried by a motion, the oracle finds it moved with it", "[moving]") {
+  // Ubiquitin from residue 55 on turned by 8 degrees about a pivot: seen
+  // moving with that turn, the other atoms moved. Independent oracle (the
+  // QP of MATH.md section 2): at points x within each proven vertex's
+  // reach, F after the turn at turn(x) equals F before at x, with the same
+  // support. A vertex whose own point is held by an atom that did not turn
+  // must not be proven, and most vertices 9 A from every such atom must be.
+  const UbiquitinTail tail = ubiquitin_tail(55);
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 0).normalized();
+  const std::vector<Ball> after = hinged(tail.start, tail.moving, tail.pivot, axis, 8.0);
+  detail::RigidMotion turn;
+  turn.rotation = Eigen::AngleAxisd(8.0 * M_PI / 180, axis).toRotationMatrix();
+  turn.translation = tail.pivot - turn.rotation * tail.pivot;
+  const SkinComplex from = build_skin_complex(tail.start);
+  const SkinMeshResult made = mesh_skin(from);
+  REQUIRE(made.status == MeshingStatus::ok);
+  const SurfaceMesh& mesh = made.mesh;
+  const std::vector<char> all(mesh.vertices.size(), 1);
+  const std::vector<double> reach = detail::judged_reach(mesh, MeshingOptions{}.tolerance, all);
+  const std::vector<Ball> seen = detail::balls_moving_with(turn, tail.start, after);
+  for (size_t b = 0; b < seen.size(); ++b)  // the turned atoms where they were, bit for bit
+    if (tail.moving[b]) CHECK((seen[b].center == tail.start[b].center && seen[b].weight == tail.start[b].weight));
+  const std::vector<char> carried = detail::skin_unchanged_near(from, seen, mesh, reach, all);
+  const SkinOracle before_oracle(tail.start, 0.5), after_oracle(after, 0.5);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  long proven = 0, far = 0, far_proven = 0, checked = 0;
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Eigen::Vector3d& x0 = mesh.vertices[v];
+    const OracleResult at = before_oracle.evaluate(x0);
+    const bool held_by_still = std::any_of(at.support.begin(), at.support.end(),
+                                           [&](const auto& b) { return tail.moving[static_cast<size_t>(b.first)] == 0; });
+    if (held_by_still) CHECK_FALSE(carried[v]);
+    double nearest = INFINITY;  // of the atoms that did not turn, at both places seen from the turn
+    for (size_t b = 0; b < after.size(); ++b)
+      if (!tail.moving[b]) nearest = std::min({nearest, (tail.start[b].center - x0).norm(), (seen[b].center - x0).norm()});
+    far += nearest > 9;
+    far_proven += nearest > 9 && carried[v];
+    if (!carried[v]) continue;
+    ++proven;
+    if (v % 3 != 0) continue;
+    for (int k = 0; k < 6; ++k) {
+      Eigen::Vector3d d(unit(random), unit(random), unit(random));
+      if (!(d.norm() > 1e-3)) continue;
+      const Eigen::Vector3d x = x0 + (k == 0 ? 1.0 : 0.5 * (1 + unit(random))) * reach[v] * d.normalized();
+      const OracleResult b = before_oracle.evaluate(x), a = after_oracle.evaluate(turn(x));
+      REQUIRE(b.certified);
+      REQUIRE(a.certified);
+      CHECK(std::abs(a.value - b.value) <= 1e-10 * (1 + std::abs(b.value)));
+      std::vector<int> sb, sa;
+      for (const auto& p : b.support) sb.push_back(p.first);
+      for (const auto& p : a.support) sa.push_back(p.first);
+      std::sort(sb.begin(), sb.end());
+      std::sort(sa.begin(), sa.end());
+      CHECK(sb == sa);
+      ++checked;
+    }
+  }
+  INFO(proven << " of " << mesh.vertices.size() << " proven; far from still atoms " << far_proven << " of " << far);
+  CHECK(checked > 1000);
+  CHECK(far > 200);
+  CHECK(far_proven > far / 2);
+  CHECK(proven < static_cast<long>(mesh.vertices.size()));
+}
+
 TEST_CASE("a matched motion leaves the atoms that do not move where they are, bit for bit", "[moving]") {
   // Ubiquitin with its last two residues turned by 6 degrees, as a user's
   // two PDB files of one domain motion: every other atom is at the same
