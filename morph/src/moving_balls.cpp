@@ -207,7 +207,7 @@ std::optional<detail::RigidMotion> largest_rigid_motion(const std::vector<Ball>&
     const detail::RigidMotion motion{rotations[b], now[b].center - rotations[b] * old[b].center};
     long count = 0;
     for (size_t k = 0; k < old.size(); ++k)
-      if (old[k].weight == now[k].weight && (motion(old[k].center) - now[k].center).norm() <= 1e-9) {
+      if (motion.carries(old[k], now[k])) {
         ++count;
         carried[k] = 1;
       }

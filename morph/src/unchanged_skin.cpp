@@ -240,13 +240,12 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
 
 std::vector<Ball> balls_moving_with(const RigidMotion& motion, const std::vector<Ball>& before,
                                     const std::vector<Ball>& after) {
-  constexpr double kCarried = 1e-9;  // Angstrom, as the judge's carried triangles (judge.hpp)
   if (before.size() != after.size()) contract_error("balls_moving_with: the ball counts differ");
   std::vector<Ball> seen(after.size());
-  for (size_t b = 0; b < after.size(); ++b) {
-    const bool carried = before[b].weight == after[b].weight && (motion(before[b].center) - after[b].center).norm() <= kCarried;
-    seen[b] = carried ? before[b] : Ball{motion.rotation.transpose() * (after[b].center - motion.translation), after[b].weight};
-  }
+  for (size_t b = 0; b < after.size(); ++b)
+    seen[b] = motion.carries(before[b], after[b])
+                  ? before[b]
+                  : Ball{motion.rotation.transpose() * (after[b].center - motion.translation), after[b].weight};
   return seen;
 }
 

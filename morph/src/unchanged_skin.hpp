@@ -38,6 +38,11 @@ struct RigidMotion {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   Eigen::Vector3d operator()(const Eigen::Vector3d& x) const { return rotation * x + translation; }
+  // Whether the motion took ball `before` to `after`, to 1e-9 A (as the
+  // judge's carried triangles, judge.hpp), its weight kept.
+  bool carries(const Ball& before, const Ball& after) const {
+    return before.weight == after.weight && ((*this)(before.center) - after.center).norm() <= 1e-9;
+  }
 };
 
 // The balls after a step (`after`) as seen by one who moved with `motion`:

@@ -103,6 +103,32 @@ UbiquitinTail ubiquitin_tail(int first) {
   return tail;
 }
 
+// At six points within `reach` of x0 (one at the full reach), the QP
+// oracle before the step at x and after it at motion(x): certified, the
+// same value (to `relative`) and the same support. Returns the points checked.
+long same_skin_around(const SkinOracle& before_oracle, const SkinOracle& after_oracle, const detail::RigidMotion& motion,
+                      const Eigen::Vector3d& x0, double reach, double relative, std::mt19937& random) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  long checked = 0;
+  for (int k = 0; k < 6; ++k) {
+    Eigen::Vector3d d(unit(random), unit(random), unit(random));
+    if (!(d.norm() > 1e-3)) continue;
+    const Eigen::Vector3d x = x0 + (k == 0 ? 1.0 : 0.5 * (1 + unit(random))) * reach * d.normalized();
+    const OracleResult b = before_oracle.evaluate(x), a = after_oracle.evaluate(motion(x));
+    REQUIRE(b.certified);
+    REQUIRE(a.certified);
+    CHECK(std::abs(a.value - b.value) <= relative * (1 + std::abs(b.value)));
+    std::vector<int> sb, sa;
+    for (const auto& p : b.support) sb.push_back(p.first);
+    for (const auto& p : a.support) sa.push_back(p.first);
+    std::sort(sb.begin(), sb.end());
+    std::sort(sa.begin(), sa.end());
+    CHECK(sb == sa);
+    ++checked;
+  }
+  return checked;
+}
+
 }  // namespace
 
 TEST_CASE("skin topology from the alpha complex: shapes of known topology", "[moving][topology]") {
@@ -359,7 +385,6 @@ TEST_CASE("skin_unchanged_near: where it proves the skin unchanged, the oracle f
   const std::vector<char> unchanged = detail::skin_unchanged_near(from, after, mesh, reach, all);
   const SkinOracle before_oracle(tail.start, 0.5), after_oracle(after, 0.5);
   std::mt19937 random(7);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   long proven = 0, far = 0, far_proven = 0, checked = 0;
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Eigen::Vector3d& x0 = mesh.vertices[v];
@@ -376,22 +401,7 @@ TEST_CASE("skin_unchanged_near: where it proves the skin unchanged, the oracle f
     if (!unchanged[v]) continue;
     ++proven;
     if (v % 5 != 0) continue;
-    for (int k = 0; k < 6; ++k) {
-      Eigen::Vector3d d(unit(random), unit(random), unit(random));
-      if (!(d.norm() > 1e-3)) continue;
-      const Eigen::Vector3d x = x0 + (k == 0 ? 1.0 : 0.5 * (1 + unit(random))) * reach[v] * d.normalized();
-      const OracleResult b = before_oracle.evaluate(x), a = after_oracle.evaluate(x);
-      REQUIRE(b.certified);
-      REQUIRE(a.certified);
-      CHECK(std::abs(a.value - b.value) <= 1e-12 * (1 + std::abs(b.value)));
-      std::vector<int> sb, sa;
-      for (const auto& p : b.support) sb.push_back(p.first);
-      for (const auto& p : a.support) sa.push_back(p.first);
-      std::sort(sb.begin(), sb.end());
-      std::sort(sa.begin(), sa.end());
-      CHECK(sb == sa);
-      ++checked;
-    }
+    checked += same_skin_around(before_oracle, after_oracle, {}, x0, reach[v], 1e-12, random);
   }
   INFO(proven << " of " << mesh.vertices.size() << " proven; far from moved atoms " << far_proven << " of " << far);
   CHECK(checked > 1000);
@@ -425,7 +435,6 @@ TEST_CASE("balls_moving_with: where the skin is proven carried by a motion, the 
   const std::vector<char> carried = detail::skin_unchanged_near(from, seen, mesh, reach, all);
   const SkinOracle before_oracle(tail.start, 0.5), after_oracle(after, 0.5);
   std::mt19937 random(11);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   long proven = 0, far = 0, far_proven = 0, checked = 0;
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Eigen::Vector3d& x0 = mesh.vertices[v];
@@ -441,22 +450,7 @@ TEST_CASE("balls_moving_with: where the skin is proven carried by a motion, the 
     if (!carried[v]) continue;
     ++proven;
     if (v % 3 != 0) continue;
-    for (int k = 0; k < 6; ++k) {
-      Eigen::Vector3d d(unit(random), unit(random), unit(random));
-      if (!(d.norm() > 1e-3)) continue;
-      const Eigen::Vector3d x = x0 + (k == 0 ? 1.0 : 0.5 * (1 + unit(random))) * reach[v] * d.normalized();
-      const OracleResult b = before_oracle.evaluate(x), a = after_oracle.evaluate(turn(x));
-      REQUIRE(b.certified);
-      REQUIRE(a.certified);
-      CHECK(std::abs(a.value - b.value) <= 1e-10 * (1 + std::abs(b.value)));
-      std::vector<int> sb, sa;
-      for (const auto& p : b.support) sb.push_back(p.first);
-      for (const auto& p : a.support) sa.push_back(p.first);
-      std::sort(sb.begin(), sb.end());
-      std::sort(sa.begin(), sa.end());
-      CHECK(sb == sa);
-      ++checked;
-    }
+    checked += same_skin_around(before_oracle, after_oracle, turn, x0, reach[v], 1e-10, random);
   }
   INFO(proven << " of " << mesh.vertices.size() << " proven; far from still atoms " << far_proven << " of " << far);
   CHECK(checked > 1000);
