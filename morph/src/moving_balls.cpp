@@ -536,8 +536,8 @@ void check_balls(const std::vector<Ball>& balls, const char* what) {
 
 SkinTopology mesh_topology(const SurfaceMesh& mesh) {
   const size_t n = mesh.vertices.size();
-  // Each edge once: per lower end, its higher ends, made unique (buckets
-  // of a few, each sorted by insertion).
+  // The edges by their lower end, each there once per triangle side; made
+  // unique below by marking the higher ends already met in the bucket.
   std::vector<int> first(n + 1, 0), higher(mesh.triangles.size() * 3);
   std::vector<char> used(n, 0);
   for (const auto& t : mesh.triangles)
@@ -553,6 +553,8 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
       const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
       higher[static_cast<size_t>(fill[static_cast<size_t>(std::min(a, b))]++)] = std::max(a, b);
     }
+  // Components by union-find, each root the least vertex of its set
+  // (parent[x] <= x), so that one pass in vertex order flattens it.
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   const auto find = [&](int x) {
@@ -561,27 +563,34 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
     return x;
   };
   long edge_count = 0;
+  std::vector<int> seen_from(n, -1);  // the lower end whose bucket last held the vertex
   for (size_t v = 0; v < n; ++v) {
-    int* const begin = higher.data() + first[v];
-    int* const end = higher.data() + first[v + 1];
-    for (int* i = begin + 1; i < end; ++i)  // insertion sort: a vertex has a handful of higher neighbours
-      for (int* j = i; j > begin && *(j - 1) > *j; --j) std::swap(*(j - 1), *j);
-    for (int* i = begin; i < end; ++i) {
-      if (i > begin && *i == *(i - 1)) continue;
+    int root = -1;
+    for (int k = first[v]; k < first[v + 1]; ++k) {
+      const int b = higher[static_cast<size_t>(k)];
+      if (seen_from[static_cast<size_t>(b)] == static_cast<int>(v)) continue;  // each edge once
+      seen_from[static_cast<size_t>(b)] = static_cast<int>(v);
       ++edge_count;
-      const int a = find(static_cast<int>(v)), b = find(*i);
-      if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+      if (root < 0) root = find(static_cast<int>(v));
+      const int other = find(b);
+      if (other < root) {
+        parent[static_cast<size_t>(root)] = other;
+        root = other;
+      } else if (other > root) {
+        parent[static_cast<size_t>(other)] = root;
+      }
     }
   }
+  for (size_t v = 0; v < n; ++v) parent[v] = parent[static_cast<size_t>(parent[v])];  // each its root
   std::vector<double> volume(n, 0.0);  // signed, per component root
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
-    volume[static_cast<size_t>(find(t[0]))] +=
+    volume[static_cast<size_t>(parent[static_cast<size_t>(t[0])])] +=
         a.dot(mesh.vertices[static_cast<size_t>(t[1])].cross(mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
   }
   SkinTopology out;
   for (size_t v = 0; v < n; ++v)
-    if (used[v] && find(static_cast<int>(v)) == static_cast<int>(v)) {
+    if (used[v] && parent[v] == static_cast<int>(v)) {
       ++out.components;
       out.voids += volume[v] < 0;
     }
