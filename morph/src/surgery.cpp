@@ -40,6 +40,14 @@ class EdgeIndex {
     }
     start_.pop_back();
     slots_.resize(static_cast<size_t>(start_.empty() ? 0 : start_.back() + room_.back()));
+    // Each directed edge of a closed oriented manifold once: no lookup.
+    for (size_t f = 0; f < triangles.size(); ++f) {
+      const auto& t = triangles[f];
+      for (size_t k = 0; k < 3; ++k) {
+        const size_t v = static_cast<size_t>(t[k]);
+        slots_[static_cast<size_t>(start_[v] + count_[v]++)] = {t[(k + 1) % 3], static_cast<int>(f)};
+      }
+    }
   }
   // The triangle holding edge from -> to, or -1.
   int face(int from, int to) const {
@@ -120,7 +128,8 @@ class Editor {
     alive_.assign(mesh_.triangles.size(), 1);
     if (still != nullptr && still->size() == mesh_.vertices.size()) still_ = *still;
     corner_face_.assign(mesh_.vertices.size(), -1);
-    for (int f = 0; f < static_cast<int>(mesh_.triangles.size()); ++f) attach(f);
+    for (int f = 0; f < static_cast<int>(mesh_.triangles.size()); ++f)
+      for (int v : tri(f)) corner_face_[static_cast<size_t>(v)] = f;
   }
 
   RepairResult run(const std::vector<char>& failing, const std::vector<long>* ids, RefusedEdges* refused);
