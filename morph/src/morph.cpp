@@ -511,7 +511,8 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
     frame_.mesh = std::move(moved.mesh);
     frame_.stats.repaired = true;
   } else {
-    const double share = options_.repair.patch.max_failing_share * static_cast<double>(moved.failing.size());
+    const double share = std::max(options_.repair.patch.max_failing_share * static_cast<double>(moved.failing.size()),
+                                   static_cast<double>(options_.repair.patch.always_patch_up_to));
     const bool small = left <= share;
     if (stats.lost > 0)
       frame_.stats.remeshed_because = std::to_string(stats.lost) + " vertices could not be put on the new skin";

@@ -1037,7 +1037,8 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   }
   lost.assign(moved.vertices.size(), 0);  // the edits renumbered the vertices; none is lost
   std::string because;
-  const double share = options_.repair.patch.max_failing_share * static_cast<double>(failing.size());
+  const double share = std::max(options_.repair.patch.max_failing_share * static_cast<double>(failing.size()),
+                                 static_cast<double>(options_.repair.patch.always_patch_up_to));
   if (left > share) {
     because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
               std::to_string(static_cast<long>(share)) + ")";

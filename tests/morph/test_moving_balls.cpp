@@ -26,6 +26,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <functional>
 #include <numeric>
@@ -721,6 +722,56 @@ TEST_CASE("moving balls: complexes built ahead, the next call's told or not, mak
     steps += b.stats.steps;
   }
   CHECK(built_ahead >= steps - 2);
+}
+
+TEST_CASE("moving balls: a step with few triangles failing after the edits is patched, not remeshed whole",
+          "[moving]") {
+  // 2k39 model 1 -> 3 (residues 1-10, about 5,300 triangles) in 101 frames,
+  // as bench_moving runs it. One step leaves more triangles failing after
+  // the edits than 1% of the frame, and is remeshed whole without
+  // PatchPolicy::always_patch_up_to; with it (moving atoms' default) no step
+  // is remeshed for fewer failing triangles than that, and every frame is
+  // certified by the engine as before.
+  ReadOptions read;
+  const Molecule first = read_molecule(test::data_file("2k39_3models.pdb"), read);
+  read.model = 3;
+  Molecule last = read_molecule(test::data_file("2k39_3models.pdb"), read);
+  last = moved(std::move(last), align(first, last, AlignmentMethod::kabsch).motion);
+  const std::vector<Ball> from = balls_from_molecule(first, 0.5), to = balls_from_molecule(last, 0.5);
+  REQUIRE(from.size() == to.size());
+  // The share a step was measured against, from its remeshed_because ("... (S)").
+  const auto share_in = [](const std::string& because) {
+    const size_t open = because.find("the local share (");
+    return open == std::string::npos ? -1L : std::stol(because.substr(open + 17));
+  };
+  const auto run = [&](long always_patch_up_to, long& remeshed, long& remeshed_for_share, long& least_share) {
+    MovingOptions options;
+    options.repair.patch.always_patch_up_to = always_patch_up_to;
+    MovingBalls moving(from, options);
+    remeshed = remeshed_for_share = 0;
+    least_share = LONG_MAX;
+    for (int k = 1; k <= 100; ++k) {
+      std::vector<Ball> balls = from;
+      for (size_t i = 0; i < balls.size(); ++i) balls[i].center += k / 100.0 * (to[i].center - from[i].center);
+      const MorphFrame& f = moving.advance_to(k == 100 ? to : balls, k / 100.0);
+      CHECK(f.stats.topology_certified);
+      remeshed += f.stats.remeshed;
+      const long share = share_in(f.stats.remeshed_because);
+      if (share >= 0) {
+        ++remeshed_for_share;
+        least_share = std::min(least_share, share);
+      }
+    }
+  };
+  long remeshed = 0, for_share = 0, least = 0;
+  run(0, remeshed, for_share, least);
+  CHECK(for_share >= 1);  // the premise
+  CHECK(least < 200);
+  const long remeshed_by_share_alone = remeshed;
+  run(MovingOptions{}.repair.patch.always_patch_up_to, remeshed, for_share, least);
+  REQUIRE(MovingOptions{}.repair.patch.always_patch_up_to == 200);
+  CHECK((for_share == 0 || least >= 200));
+  CHECK(remeshed < remeshed_by_share_alone);
 }
 
 TEST_CASE("moving balls: ubiquitin's atoms in thermal motion, voids opening and closing, every frame valid", "[moving][large]") {

@@ -105,6 +105,7 @@ struct MovingOptions {
     r.patch.retry_around_faults = true;
     r.patch.wider_rings = 1;
     r.patch.local_reach_cap = 6;  // target edge lengths
+    r.patch.always_patch_up_to = 200;  // triangles
     return r;
   }();
 };

@@ -44,6 +44,11 @@ struct PatchPolicy {
   // the edits (a share, 0-1; 0: never); past it the patches cover much of
   // the mesh and remeshing the whole frame from its vertices is faster.
   double max_failing_share = 0.01;
+  // ... or at most this many triangles, whatever the share (a count; 0:
+  // the share alone). On a small frame the share is a few dozen triangles,
+  // a patch of which costs a fraction of remeshing the frame whole. Moving
+  // atoms take 200 (moving_balls.hpp).
+  long always_patch_up_to = 0;
   // Rings of triangles around the failing ones that join the patch (a
   // count): one ring mends as many frames as two, at less cost, and none
   // mends fewer.
