@@ -294,15 +294,15 @@ std::vector<double> longest_edges(const SurfaceMesh& mesh) {
 std::vector<Continuity> continuity_bounds(const SkinComplex& from, const SkinComplex& to, const SurfaceMesh& mesh,
                                          double continuity) {
   const std::vector<double> longest = longest_edges(mesh);
+  std::vector<double> ball_moved(from.balls().size());
+  for (size_t b = 0; b < ball_moved.size(); ++b) ball_moved[b] = ball_move(from.balls()[b], to.balls()[b]);
   std::vector<Continuity> out(mesh.vertices.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       const MixedCell& cell = from.cell(mesh.cells[v]);
       double balls_moved = 0;
-      for (int i = 0; i <= cell.dim; ++i) {
-        const size_t b = static_cast<size_t>(cell.balls[static_cast<size_t>(i)]);
-        balls_moved = std::max(balls_moved, ball_move(from.balls()[b], to.balls()[b]));
-      }
+      for (int i = 0; i <= cell.dim; ++i)
+        balls_moved = std::max(balls_moved, ball_moved[static_cast<size_t>(cell.balls[static_cast<size_t>(i)])]);
       out[v] = {mesh.vertices[v], balls_moved + continuity * longest[v]};
     }
   });
@@ -886,23 +886,26 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   settled.verdict.settled.assign(n, 0);
   settled.verdict.carried.assign(n, 0);
   settled.thinning.assign(n, 0);
-  bool carried_by_motion = false;
-  for (size_t v = 0; v < n; ++v) {
-    lost[v] = fates[v] == VertexFate::lost;
-    stayed[v] = stayed_put(fates[v]);
-    const MixedCell& cell = next.cell(moved.cells[v]);
-    const bool ring_settled =
-        all_passed_ && fates[v] == VertexFate::kept && cell_of_flagged_balls(cell, settled_balls);
-    settled.verdict.settled[v] = ring_settled || unchanged[v];
-    // A vertex settled by its rings of still atoms is carried (by no motion) too.
-    const bool carried = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls);
-    settled.verdict.carried[v] = ring_settled || carried || carried_along[v];
-    carried_by_motion = carried_by_motion || ((carried || carried_along[v]) && !ring_settled);
-    settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, rigid_balls);
-    s.moved += stayed[v];
-    s.relocated += fates[v] == VertexFate::relocated;
-    s.lost += lost[v];
-  }
+  std::vector<char> by_motion(n, 0);  // carried, not settled by rings of still atoms
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      lost[v] = fates[v] == VertexFate::lost;
+      stayed[v] = stayed_put(fates[v]);
+      const MixedCell& cell = next.cell(moved.cells[v]);
+      const bool ring_settled =
+          all_passed_ && fates[v] == VertexFate::kept && cell_of_flagged_balls(cell, settled_balls);
+      settled.verdict.settled[v] = ring_settled || unchanged[v];
+      // A vertex settled by its rings of still atoms is carried (by no motion) too.
+      const bool carried = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, carried_balls);
+      settled.verdict.carried[v] = ring_settled || carried || carried_along[v];
+      by_motion[v] = (carried || carried_along[v]) && !ring_settled;
+      settled.thinning[v] = all_passed_ && stayed[v] && cell_of_flagged_balls(cell, rigid_balls);
+    }
+  });
+  const bool carried_by_motion = std::find(by_motion.begin(), by_motion.end(), 1) != by_motion.end();
+  s.moved += std::count(stayed.begin(), stayed.end(), 1);
+  s.relocated += std::count(fates.begin(), fates.end(), VertexFate::relocated);
+  s.lost += std::count(lost.begin(), lost.end(), 1);
   // The places before the step only where a vertex is carried by a motion
   // (KnownVerdicts::before): a triangle of ring-settled corners alone is settled.
   if (carried_by_motion) settled.verdict.before = frame_.mesh.vertices;
