@@ -170,6 +170,8 @@ class Editor {
   }
   // The vertices around v, in order (the corner after v in each triangle).
   std::vector<int> ring(int v) const;
+  // The triangles around v, in the same order.
+  std::vector<int> star(int v) const;
 
   Verdict judge(int f) const;
   bool should_flip(int a, int b) const;
@@ -180,6 +182,27 @@ class Editor {
   bool try_contract(int f, std::vector<int>& touched);
   bool contract(int gone, int kept, std::vector<int>& touched);
   void thin_crowded(std::unordered_map<int, int>& seen, const std::vector<long>* ids, RefusedEdges* refused);
+  struct Thinning {
+    std::vector<char> near;             // per vertex
+    std::vector<double> target;         // per vertex, Angstrom; -1: not worked out yet
+    std::vector<unsigned char> to_try;  // per triangle, bit k: its edge k is to be tried
+  };
+  Thinning thinning_marks() const;
+  void mark_after_contraction(const std::vector<int>& touched, Thinning& th) const;
+  // Bit k set where edge k of triangle f (lower end first) has an end near
+  // a change and is shorter than thin_below times the target at its ends.
+  template <class TargetOf>
+  unsigned char edges_to_try(size_t f, const std::vector<char>& near, TargetOf&& target_of) const {
+    unsigned char bits = 0;
+    const Triangle& t = mesh_.triangles[f];
+    for (size_t k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a < b && (near[static_cast<size_t>(a)] || near[static_cast<size_t>(b)]) &&
+          (at(a) - at(b)).norm() < options_.thin_below * std::min(target_of(a), target_of(b)))
+        bits = static_cast<unsigned char>(bits | (1u << k));
+    }
+    return bits;
+  }
   void unsettle(const std::vector<int>& touched);
   std::vector<char> near_change() const;
 
@@ -203,6 +226,21 @@ std::vector<int> Editor::ring(int v) const {
     const Triangle& t = tri(f);
     const size_t k = static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin());
     out.push_back(t[(k + 1) % 3]);
+    f = face_of(v, t[(k + 2) % 3]);  // across the edge into v
+    if (f < 0 || out.size() > 64) return {};
+  } while (f != start);
+  return out;
+}
+
+std::vector<int> Editor::star(int v) const {
+  std::vector<int> out;
+  const int start = corner_face_[static_cast<size_t>(v)];
+  if (start < 0) return out;
+  int f = start;
+  do {
+    out.push_back(f);
+    const Triangle& t = tri(f);
+    const size_t k = static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin());
     f = face_of(v, t[(k + 2) % 3]);  // across the edge into v
     if (f < 0 || out.size() > 64) return {};
   } while (f != start);
@@ -420,72 +458,114 @@ std::vector<char> Editor::near_change() const {
   return near;
 }
 
+// Thinning contractions refused in the frame before (RefusedEdges, by the
+// ids of the edge's ends), and those refused in this one.
+class RefusalMemo {
+ public:
+  RefusalMemo(const std::vector<long>* ids, RefusedEdges* refused, const EditPolicy& options)
+      : ids_(ids), refused_(refused), options_(options) {
+    if (refused_) {
+      before_.swap(*refused_);
+      refused_->reserve(before_.size());
+    }
+  }
+  // The edge a - b by the ids of its ends; none without a memo, or for a
+  // vertex a split made in this frame (its edges are new).
+  std::optional<std::pair<long, long>> key_of(int a, int b) const {
+    if (!ids_ || !refused_ || static_cast<size_t>(std::max(a, b)) >= ids_->size()) return std::nullopt;
+    const long ia = (*ids_)[static_cast<size_t>(a)], ib = (*ids_)[static_cast<size_t>(b)];
+    return std::make_pair(std::min(ia, ib), std::max(ia, ib));
+  }
+  // Refused in a frame before, neither shrunk since nor aged: skipped, and
+  // remembered a frame older.
+  bool still_refused(const std::optional<std::pair<long, long>>& key, double length) {
+    if (!key) return false;
+    const auto it = before_.find(*key);
+    if (it == before_.end()) return false;
+    const auto [length_then, age] = it->second;
+    if (length < (1 - options_.retry_shrink) * length_then || age + 1 >= options_.retry_after_frames) return false;
+    refused_->emplace(*key, std::make_pair(length_then, age + 1));
+    return true;
+  }
+  void refuse(const std::optional<std::pair<long, long>>& key, double length) {
+    if (key) refused_->emplace(*key, std::make_pair(length, 0));
+  }
+
+ private:
+  const std::vector<long>* ids_;
+  RefusedEdges* refused_;
+  const EditPolicy& options_;
+  RefusedEdges before_;
+};
+
+// The thinning's marks: per vertex, near a change (near_change) and its
+// target edge length (-1: not worked out yet); per triangle, bit k set
+// where its edge k (lower end first) is near a change and shorter than
+// thin_below times the target at its ends. Found in parallel.
+Editor::Thinning Editor::thinning_marks() const {
+  Thinning th;
+  th.near = near_change();
+  const size_t n = mesh_.vertices.size();
+  th.target.assign(n, -1);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      if (corner_face_[v] >= 0 && th.near[v])
+        th.target[v] = target_edge_length(complex_, mesh_.vertices[v], mesh_.cells[v], accept_);
+  });
+  th.to_try.assign(mesh_.triangles.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, th.to_try.size(), 2048), [&](const tbb::blocked_range<size_t>& r) {
+    const auto known_target = [&](int v) {  // not cached: other threads read `target`
+      const double t = th.target[static_cast<size_t>(v)];
+      return t >= 0 ? t : target_edge_length(complex_, at(v), mesh_.cells[static_cast<size_t>(v)], accept_);
+    };
+    for (size_t f = r.begin(); f != r.end(); ++f)
+      if (alive_[f]) th.to_try[f] = edges_to_try(f, th.near, known_target);
+  });
+  return th;
+}
+
+// The marks kept up to date after a contraction: the triangles it changed
+// (`touched`) and those around the vertices it brought near a change.
+void Editor::mark_after_contraction(const std::vector<int>& touched, Thinning& th) const {
+  const auto target_at = [&](int v) {
+    double& t = th.target[static_cast<size_t>(v)];
+    if (t < 0) t = target_edge_length(complex_, at(v), mesh_.cells[static_cast<size_t>(v)], accept_);
+    return t;
+  };
+  std::vector<int> newly_near;
+  for (int h : touched)
+    for (int v : tri(h))  // its fan changed
+      if (!th.near[static_cast<size_t>(v)]) th.near[static_cast<size_t>(v)] = 1, newly_near.push_back(v);
+  for (int v : newly_near)
+    for (int h : star(v)) th.to_try[static_cast<size_t>(h)] = edges_to_try(static_cast<size_t>(h), th.near, target_at);
+  for (int h : touched) th.to_try[static_cast<size_t>(h)] = edges_to_try(static_cast<size_t>(h), th.near, target_at);
+}
+
 // Every edge shorter than thin_below times the target edge length at its
 // ends is contracted where that keeps every guarantee (contract): splits
 // add vertices where the skin stretches, and this takes them away where it
 // shrinks, so that the vertex count follows the surface. With still marks,
 // only edges near a change are tried (near_change).
 void Editor::thin_crowded(std::unordered_map<int, int>& seen, const std::vector<long>* ids, RefusedEdges* refused) {
-  const size_t n = mesh_.vertices.size();
-  RefusedEdges before;
-  if (refused) {
-    before.swap(*refused);
-    refused->reserve(before.size());
-  }
-  // The edge a - b by the ids of its ends; none without a memo, or for a
-  // vertex a split made in this frame (its edges are new).
-  auto key_of = [&](int a, int b) -> std::optional<std::pair<long, long>> {
-    if (!ids || !refused || static_cast<size_t>(std::max(a, b)) >= ids->size()) return std::nullopt;
-    const long ia = (*ids)[static_cast<size_t>(a)], ib = (*ids)[static_cast<size_t>(b)];
-    return std::make_pair(std::min(ia, ib), std::max(ia, ib));
-  };
-  // Refused in a frame before, neither shrunk since nor aged: skipped, and
-  // remembered a frame older.
-  auto still_refused = [&](const std::optional<std::pair<long, long>>& key, double length) {
-    if (!key) return false;
-    const auto it = before.find(*key);
-    if (it == before.end()) return false;
-    const auto [length_then, age] = it->second;
-    if (length < (1 - options_.retry_shrink) * length_then || age + 1 >= options_.retry_after_frames) return false;
-    refused->emplace(*key, std::make_pair(length_then, age + 1));
-    return true;
-  };
-  std::vector<char> near = near_change();
-  std::vector<double> target(n, -1);  // -1: not worked out yet
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v)
-      if (corner_face_[v] >= 0 && near[v])
-        target[v] = target_edge_length(complex_, mesh_.vertices[v], mesh_.cells[v], accept_);
-  });
-  const auto target_at = [&](int v) {
-    double& t = target[static_cast<size_t>(v)];
-    if (t < 0) t = target_edge_length(complex_, at(v), mesh_.cells[static_cast<size_t>(v)], accept_);
-    return t;
-  };
+  RefusalMemo memo(ids, refused, options_);
+  Thinning th = thinning_marks();
   std::vector<int> touched;
-  const size_t faces = mesh_.triangles.size();
-  for (size_t f = 0; f < faces; ++f) {
-    if (!alive_[f]) continue;
-    for (size_t k = 0; k < 3; ++k) {
+  for (size_t f = 0; f < th.to_try.size(); ++f) {
+    for (size_t k = 0; k < 3 && th.to_try[f]; ++k) {
+      if (!alive_[f] || !(th.to_try[f] & (1u << k))) continue;
       const Triangle& t = mesh_.triangles[f];
       const int a = t[k], b = t[(k + 1) % 3];
-      if (a > b) continue;  // each edge once
-      if (!near[static_cast<size_t>(a)] && !near[static_cast<size_t>(b)]) continue;
-      const double limit = options_.thin_below * std::min(target_at(a), target_at(b));
       const double length = (at(a) - at(b)).norm();
-      if (!(length < limit)) continue;
-      const auto key = key_of(a, b);
-      if (still_refused(key, length)) continue;
+      const auto key = memo.key_of(a, b);
+      if (memo.still_refused(key, length)) continue;
       touched.clear();
       ++thin_tried_;
       if (!contract(b, a, touched) && !contract(a, b, touched)) {
-        if (key) refused->emplace(*key, std::make_pair(length, 0));
+        memo.refuse(key, length);
         continue;
       }
-      for (int h : touched) {
-        seen.emplace(h, 0);
-        for (int v : tri(h)) near[static_cast<size_t>(v)] = 1;  // its fan changed
-      }
+      for (int h : touched) seen.emplace(h, 0);
+      mark_after_contraction(touched, th);
       break;  // this triangle is gone
     }
   }
