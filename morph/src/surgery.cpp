@@ -606,9 +606,19 @@ RepairResult Editor::run(const std::vector<char>& failing, const std::vector<lon
   std::vector<int> kept_from;
   out.mesh = used_part(mesh_, alive_, kept_from);
   for (int v : kept_from) out.origin.push_back(static_cast<size_t>(v) < vertices_before_ ? v : -1);
+  // The triangles an edit made or that failed, judged again in parallel;
+  // the others kept the verdict pass.
+  std::vector<int> again;
+  again.reserve(seen.size());
+  for (const auto& entry : seen)
+    if (alive_[static_cast<size_t>(entry.first)]) again.push_back(entry.first);
+  std::vector<char> fails(mesh_.triangles.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, again.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i)
+      fails[static_cast<size_t>(again[i])] = judge(again[i]) != Verdict::pass;
+  });
   for (size_t f = 0; f < mesh_.triangles.size(); ++f)
-    if (alive_[f])
-      out.failing.push_back(seen.count(static_cast<int>(f)) && judge(static_cast<int>(f)) != Verdict::pass);
+    if (alive_[f]) out.failing.push_back(fails[f]);
   out.left = std::count(out.failing.begin(), out.failing.end(), 1);
   out.counts.splits = splits_;
   out.counts.flips = flips_;
