@@ -168,10 +168,11 @@ class Editor {
       if (!(n.dot(mesh_.normals[static_cast<size_t>(v)]) > 0)) return false;
     return true;
   }
-  // The vertices around v, in order (the corner after v in each triangle).
-  std::vector<int> ring(int v) const;
-  // The triangles around v, in the same order.
+  // The triangles around v, in order across the edges into v (none where
+  // they are not one closed fan of at most 64).
   std::vector<int> star(int v) const;
+  // The vertices around v, in the same order (the corner after v in each triangle).
+  std::vector<int> ring(int v) const;
 
   Verdict judge(int f) const;
   bool should_flip(int a, int b) const;
@@ -218,20 +219,6 @@ class Editor {
   long splits_ = 0, flips_ = 0, contractions_ = 0, thin_tried_ = 0;
 };
 
-std::vector<int> Editor::ring(int v) const {
-  std::vector<int> out;
-  const int start = corner_face_[static_cast<size_t>(v)];
-  int f = start;
-  do {
-    const Triangle& t = tri(f);
-    const size_t k = static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin());
-    out.push_back(t[(k + 1) % 3]);
-    f = face_of(v, t[(k + 2) % 3]);  // across the edge into v
-    if (f < 0 || out.size() > 64) return {};
-  } while (f != start);
-  return out;
-}
-
 std::vector<int> Editor::star(int v) const {
   std::vector<int> out;
   const int start = corner_face_[static_cast<size_t>(v)];
@@ -244,6 +231,15 @@ std::vector<int> Editor::star(int v) const {
     f = face_of(v, t[(k + 2) % 3]);  // across the edge into v
     if (f < 0 || out.size() > 64) return {};
   } while (f != start);
+  return out;
+}
+
+std::vector<int> Editor::ring(int v) const {
+  std::vector<int> out;
+  for (int f : star(v)) {
+    const Triangle& t = tri(f);
+    out.push_back(t[(static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin()) + 1) % 3]);
+  }
   return out;
 }
 
