@@ -131,6 +131,18 @@ long same_skin_around(const SkinOracle& before_oracle, const SkinOracle& after_o
   return checked;
 }
 
+// The balls of data/2k39_3models.pdb's model 1 and of its model 3 fitted
+// onto model 1 by Kabsch (residues 1-10; shrink factor 1/2).
+std::pair<std::vector<Ball>, std::vector<Ball>> models_1_and_3_of_2k39() {
+  ReadOptions read;
+  const Molecule first = read_molecule(test::data_file("2k39_3models.pdb"), read);
+  read.model = 3;
+  Molecule last = read_molecule(test::data_file("2k39_3models.pdb"), read);
+  const RigidMotion fit = align(first, last, AlignmentMethod::kabsch).motion;  // before last is moved from
+  last = moved(std::move(last), fit);
+  return {balls_from_molecule(first, 0.5), balls_from_molecule(last, 0.5)};
+}
+
 }  // namespace
 
 TEST_CASE("skin topology from the alpha complex: shapes of known topology", "[moving][topology]") {
@@ -688,13 +700,9 @@ TEST_CASE("moving balls: complexes built ahead, the next call's told or not, mak
   // frames, against an engine that builds every complex in its own step.
   // Frame 3 announces model 3 itself while frame 4 follows: what was
   // built ahead is not the step asked for, and must not be used.
-  ReadOptions read;
-  const Molecule first = read_molecule(test::data_file("2k39_3models.pdb"), read);
-  read.model = 3;
-  Molecule last = read_molecule(test::data_file("2k39_3models.pdb"), read);
-  const RigidMotion fit = align(first, last, AlignmentMethod::kabsch).motion;  // before last is moved from
-  last = moved(std::move(last), fit);
-  const std::vector<Ball> from = balls_from_molecule(first, 0.5), to = balls_from_molecule(last, 0.5);
+  const auto models = models_1_and_3_of_2k39();
+  const std::vector<Ball>& from = models.first;
+  const std::vector<Ball>& to = models.second;
   REQUIRE(from.size() == to.size());
   const auto frame_balls = [&](int k) {
     std::vector<Ball> balls = from;
@@ -732,12 +740,9 @@ TEST_CASE("moving balls: a step with few triangles failing after the edits is pa
   // PatchPolicy::always_patch_up_to; with it (moving atoms' default) no step
   // is remeshed for fewer failing triangles than that, and every frame is
   // certified by the engine as before.
-  ReadOptions read;
-  const Molecule first = read_molecule(test::data_file("2k39_3models.pdb"), read);
-  read.model = 3;
-  Molecule last = read_molecule(test::data_file("2k39_3models.pdb"), read);
-  last = moved(std::move(last), align(first, last, AlignmentMethod::kabsch).motion);
-  const std::vector<Ball> from = balls_from_molecule(first, 0.5), to = balls_from_molecule(last, 0.5);
+  const auto models = models_1_and_3_of_2k39();
+  const std::vector<Ball>& from = models.first;
+  const std::vector<Ball>& to = models.second;
   REQUIRE(from.size() == to.size());
   // The share a step was measured against, from its remeshed_because ("... (S)").
   const auto share_in = [](const std::string& because) {
