@@ -1,5 +1,4 @@
 #include "local_repair.hpp"
-#include "skinmesh/core/point_grid.hpp"
 
 #include "judge.hpp"
 #include "mesh_part.hpp"
@@ -105,6 +104,66 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
 // may give up for want of progress.
 constexpr int kAttemptsBeforeGivingUp = 4;
 
+// Vertices in a box, sorted into cubic cells of one width held in one
+// array (a counting sort): built for each attempt of a patch from tens of
+// thousands of vertices, where hashing each into a PointGrid cost more
+// than the context search itself.
+class BoxGrid {
+ public:
+  // `cell` (Angstrom, > 0) widens so that there are at most a few cells a vertex.
+  BoxGrid(const SurfaceMesh& mesh, const std::vector<int>& vertices, const Eigen::AlignedBox3d& box, double cell)
+      : mesh_(mesh), origin_(box.min()) {
+    const double most_cells = 4.0 * static_cast<double>(vertices.size()) + 64;
+    const Eigen::Vector3d extent = box.sizes();
+    double cells = 1;
+    for (int k = 0; k < 3; ++k) cells *= std::floor(std::max(extent[k], 0.0) / cell) + 1;
+    cell_ = cells > most_cells ? cell * std::cbrt(cells / most_cells) : cell;
+    dims_ = ((extent / cell_).array().floor().cast<int>() + 1).cwiseMax(1);
+    start_.assign(static_cast<size_t>(dims_.prod()) + 1, 0);
+    for (int v : vertices) ++start_[index(cell_of(at(v))) + 1];
+    for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    items_.resize(vertices.size());
+    points_.resize(vertices.size());
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (int v : vertices) {
+      const auto q = static_cast<size_t>(fill[index(cell_of(at(v)))]++);
+      items_[q] = v;
+      points_[q] = at(v);
+    }
+  }
+  // Calls visit(v, point of v) for every vertex in the cells that the cube
+  // of half-width `radius` about p meets.
+  template <class Visit>
+  void each_near(const Eigen::Vector3d& p, double radius, Visit visit) const {
+    const Eigen::Vector3i lo = cell_of(p.array() - radius), hi = cell_of(p.array() + radius);
+    for (int i = lo.x(); i <= hi.x(); ++i)
+      for (int j = lo.y(); j <= hi.y(); ++j)
+        for (int k = lo.z(); k <= hi.z(); ++k) {
+          const size_t at_cell = index({i, j, k});
+          for (int q = start_[at_cell]; q < start_[at_cell + 1]; ++q)
+            visit(items_[static_cast<size_t>(q)], points_[static_cast<size_t>(q)]);
+        }
+  }
+
+ private:
+  const Eigen::Vector3d& at(int v) const { return mesh_.vertices[static_cast<size_t>(v)]; }
+  Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3i c = ((p - origin_) / cell_).array().floor().cast<int>();
+    return c.cwiseMax(0).cwiseMin(dims_ - Eigen::Vector3i::Ones());
+  }
+  size_t index(const Eigen::Vector3i& c) const {
+    return (static_cast<size_t>(c.x()) * static_cast<size_t>(dims_.y()) + static_cast<size_t>(c.y())) *
+               static_cast<size_t>(dims_.z()) +
+           static_cast<size_t>(c.z());
+  }
+  const SurfaceMesh& mesh_;
+  Eigen::Vector3d origin_;
+  double cell_ = 1;
+  Eigen::Vector3i dims_;
+  std::vector<int> start_, items_;
+  std::vector<Eigen::Vector3d> points_;  // of items_, in their order: read together
+};
+
 // Vertices near the patch that the mesh does not join to it (another sheet
 // across a thin gap, the far side of a narrow neck) become context too.
 // Without them the Voronoi edge of a patch facet runs on across the gap, its
@@ -130,9 +189,6 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
     reaches.push_back(reach[v]);
   }
   if (reaches.empty()) return true;
-  // Grid cells as wide as the median reach: most vertices search 27 cells.
-  std::nth_element(reaches.begin(), reaches.begin() + static_cast<long>(reaches.size() / 2), reaches.end());
-  PointGrid<int> grid(reaches[reaches.size() / 2]);  // vertices outside the patch
   // Only vertices in the patch's bounding box grown by the longest reach
   // can be near it: the grid holds those, not the whole frame.
   Eigen::AlignedBox3d near_box;
@@ -145,10 +201,15 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   near_box.min().array() -= farthest;
   near_box.max().array() += farthest;
   // A vertex no triangle uses (one an earlier part of the patch dropped) is no context.
+  std::vector<int> outside;  // the patch
   for (int v = 0; v < static_cast<int>(mesh.vertices.size()); ++v)
     if (role[static_cast<size_t>(v)] == kNone && near_box.contains(mesh.vertices[static_cast<size_t>(v)]) &&
         !stars.empty(v))
-      grid.insert(mesh.vertices[static_cast<size_t>(v)], v);
+      outside.push_back(v);
+  // Grid cells half as wide as the median reach: most vertices search
+  // 27-64 cells, about 3-8 times the volume of their ball.
+  std::nth_element(reaches.begin(), reaches.begin() + static_cast<long>(reaches.size() / 2), reaches.end());
+  const BoxGrid grid(mesh, outside, near_box, 0.5 * reaches[reaches.size() / 2]);
   size_t taken = static_cast<size_t>(std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; }));
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and the list could outgrow
@@ -156,13 +217,14 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   for (size_t v = 0; v < role.size(); ++v) {
     if (!(reach[v] > 0)) continue;
     const Eigen::Vector3d& p = mesh.vertices[v];
-    grid.any_near(p, static_cast<int>(std::ceil(reach[v] / grid.cell())), [&](int w) {
+    const double reach2 = reach[v] * reach[v];
+    grid.each_near(p, reach[v], [&](int w, const Eigen::Vector3d& q) {
+      if ((q - p).squaredNorm() >= reach2) return;
       signed char& r = role[static_cast<size_t>(w)];
-      if (r == kNone && (mesh.vertices[static_cast<size_t>(w)] - p).squaredNorm() < reach[v] * reach[v]) {
+      if (r == kNone) {
         r = context;
         ++taken;
       }
-      return false;
     });
     if (taken > most) return false;
   }
@@ -299,28 +361,46 @@ std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, 
                              const std::vector<Triangle>& fresh, const std::vector<signed char>& role,
                              const std::vector<char>& drop, std::vector<int>& open_new) {
   const size_t old_vertices = mesh.vertices.size();
-  auto in_patch = [&](int v) {
-    return static_cast<size_t>(v) >= old_vertices ||
-           role[static_cast<size_t>(v)] == static_cast<signed char>(PatchRole::interior) ||
-           role[static_cast<size_t>(v)] == static_cast<signed char>(PatchRole::boundary);
+  auto in_patch = [&](size_t v) {
+    return v >= old_vertices || role[v] == static_cast<signed char>(PatchRole::interior) ||
+           role[v] == static_cast<signed char>(PatchRole::boundary);
   };
-  std::unordered_map<int, std::vector<Triangle>> around;
+  size_t vertices = old_vertices;
   for (const Triangle& t : fresh)
-    for (int v : t) around[v].push_back(t);
-  for (int v = 0; v < static_cast<int>(old_vertices); ++v)
+    for (int v : t) vertices = std::max(vertices, static_cast<size_t>(v) + 1);
+  // The triangles around each patch vertex (the patch's, then the kept
+  // ones), in compressed rows: `first[v]` to `first[v + 1]` in `around`.
+  std::vector<int> first(vertices + 1, 0);
+  for (const Triangle& t : fresh)
+    for (int v : t) ++first[static_cast<size_t>(v) + 1];
+  for (size_t v = 0; v < old_vertices; ++v)
     if (in_patch(v))
-      stars.each(v, [&](int f) {
-        if (!region[static_cast<size_t>(f)]) around[v].push_back(mesh.triangles[static_cast<size_t>(f)]);
+      stars.each(static_cast<int>(v), [&](int f) { first[v + 1] += !region[static_cast<size_t>(f)]; });
+  for (size_t v = 1; v <= vertices; ++v) first[v] += first[v - 1];
+  std::vector<Triangle> around(static_cast<size_t>(first.back()));
+  std::vector<int> fill(first.begin(), first.end() - 1);
+  for (const Triangle& t : fresh)
+    for (int v : t) around[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
+  for (size_t v = 0; v < old_vertices; ++v)
+    if (in_patch(v))
+      stars.each(static_cast<int>(v), [&](int f) {
+        if (!region[static_cast<size_t>(f)]) around[static_cast<size_t>(fill[v]++)] = mesh.triangles[static_cast<size_t>(f)];
       });
   std::vector<int> faults;
-  for (size_t v = 0; v < old_vertices; ++v)  // an interior vertex may go; a rim vertex has kept triangles
-    if (role[v] == static_cast<signed char>(PatchRole::boundary) && !drop[v] && !around.count(static_cast<int>(v)))
-      faults.push_back(static_cast<int>(v));
-  for (const auto& [v, triangles] : around) {
-    if (!in_patch(v) || star_is_disk(v, triangles)) continue;
-    if (static_cast<size_t>(v) < old_vertices) faults.push_back(v);
-    else open_new.push_back(v);
-    for (const Triangle& t : triangles)
+  std::vector<Triangle> star;
+  for (size_t v = 0; v < vertices; ++v) {
+    const auto from = around.begin() + first[v], to = around.begin() + first[v + 1];
+    // an interior vertex may go; a rim vertex has kept triangles
+    if (from == to) {
+      if (v < old_vertices && role[v] == static_cast<signed char>(PatchRole::boundary) && !drop[v])
+        faults.push_back(static_cast<int>(v));
+      continue;
+    }
+    star.assign(from, to);
+    if (!in_patch(v) || star_is_disk(static_cast<int>(v), star)) continue;
+    if (v < old_vertices) faults.push_back(static_cast<int>(v));
+    else open_new.push_back(static_cast<int>(v));
+    for (const Triangle& t : star)
       for (int w : t)
         if (static_cast<size_t>(w) < old_vertices) faults.push_back(w);
   }
@@ -384,20 +464,38 @@ std::vector<SkinSample> patch_samples(const SurfaceMesh& mesh, const std::vector
   return samples;
 }
 
+// Whether the mesh has a triangle outside `region` on the corners of `t`
+// (in any order): the patch meshed it again as the mesh has it.
+bool kept_already(const SurfaceMesh& mesh, const VertexStars& stars, const std::vector<char>& region,
+                  const Triangle& t) {
+  Triangle key = t;
+  std::sort(key.begin(), key.end());
+  bool found = false;
+  stars.each(t[0], [&](int f) {
+    if (found || region[static_cast<size_t>(f)]) return;
+    Triangle corners = mesh.triangles[static_cast<size_t>(f)];
+    std::sort(corners.begin(), corners.end());
+    found = corners == key;
+  });
+  return found;
+}
+
 // The patch's triangles in the mesh's numbering (new points after the
 // mesh's vertices), without those the mesh keeps already.
-std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const PatchMeshResult& patch,
-                                      const std::vector<int>& index, const std::vector<Triangle>& kept_near) {
+std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const VertexStars& stars,
+                                      const std::vector<char>& region, const PatchMeshResult& patch,
+                                      const std::vector<int>& index) {
   const long n = static_cast<long>(index.size());
   std::vector<Triangle> out;
   for (const auto& t : patch.triangles) {
     Triangle g;
-    for (size_t k = 0; k < 3; ++k)
+    bool old_corners = true;
+    for (size_t k = 0; k < 3; ++k) {
+      old_corners = old_corners && t[k] < n;
       g[k] = t[k] < n ? index[static_cast<size_t>(t[k])]
                       : static_cast<int>(mesh.vertices.size() + static_cast<size_t>(t[k] - n));
-    Triangle key = g;
-    std::sort(key.begin(), key.end());
-    if (!std::binary_search(kept_near.begin(), kept_near.end(), key)) out.push_back(g);
+    }
+    if (!old_corners || !kept_already(mesh, stars, region, g)) out.push_back(g);
   }
   return out;
 }
@@ -522,18 +620,7 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
     return a;
   }
   a.meshed = true;
-  std::vector<Triangle> kept_near;  // kept triangles at the rim, by sorted corners, sorted
-  for (int v = 0; v < static_cast<int>(role.size()); ++v)
-    if (role[static_cast<size_t>(v)] != kNone)
-      stars.each(v, [&](int f) {
-        if (region[static_cast<size_t>(f)]) return;
-        Triangle key = mesh.triangles[static_cast<size_t>(f)];
-        std::sort(key.begin(), key.end());
-        kept_near.push_back(key);
-      });
-  std::sort(kept_near.begin(), kept_near.end());
-  kept_near.erase(std::unique(kept_near.begin(), kept_near.end()), kept_near.end());
-  a.fresh = patch_triangles(mesh, patch, index, kept_near);
+  a.fresh = patch_triangles(mesh, stars, region, patch, index);
   a.added = std::move(patch.added);
   a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop, a.open_new);
   add_near_open_stars(mesh, role, a.added, a.fresh, a.open_new, options.policy.open_star_reach, a.faults);
@@ -728,13 +815,21 @@ SurfaceMesh with_seeds_at_changes(const SkinComplex& complex, const SurfaceMesh&
   return seeded;
 }
 
-// The triangles with a corner near a topology change.
+// The triangles with a corner near a topology change (each vertex
+// tested once, in parallel: a frame has up to dozens of changes).
 void mark_near_changes(const SurfaceMesh& mesh, const std::vector<TopologyChange>& changes,
                        std::vector<char>& region) {
+  if (changes.empty()) return;
+  std::vector<char> near(mesh.vertices.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, near.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      near[v] = std::any_of(changes.begin(), changes.end(), [&](const TopologyChange& c) {
+        return (mesh.vertices[v] - c.point).squaredNorm() <= c.radius * c.radius;
+      });
+  });
   for (size_t f = 0; f < mesh.triangles.size(); ++f)
-    for (const TopologyChange& c : changes)
-      for (int v : mesh.triangles[f])
-        if ((mesh.vertices[static_cast<size_t>(v)] - c.point).squaredNorm() <= c.radius * c.radius) region[f] = 1;
+    for (int v : mesh.triangles[f])
+      if (near[static_cast<size_t>(v)]) region[f] = 1;
 }
 
 // V - E + F of a closed triangle mesh (every edge in two triangles, so
