@@ -235,8 +235,10 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
 // triangles within `rings` rings of it (0 elsewhere).
 std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vector<char>& region, int rings) {
   std::vector<double> longest(mesh.vertices.size(), 0.0);
-  for (size_t f = 0; f < region.size(); ++f) {
-    if (!region[f]) continue;
+  std::vector<size_t> in_region;
+  for (size_t f = 0; f < region.size(); ++f)
+    if (region[f]) in_region.push_back(f);
+  for (size_t f : in_region) {
     const Triangle& t = mesh.triangles[f];
     double edge = 0;
     for (size_t k = 0; k < 3; ++k)
@@ -244,16 +246,18 @@ std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vect
                              mesh.vertices[static_cast<size_t>(t[(k + 1) % 3])]).norm());
     for (int v : t) longest[static_cast<size_t>(v)] = std::max(longest[static_cast<size_t>(v)], edge);
   }
+  // Each ring: every triangle's largest corner value, read before any is
+  // raised, goes to its corners.
+  std::vector<double> most(in_region.size());
   for (int r = 0; r < rings; ++r) {
-    std::vector<double> wider = longest;
-    for (size_t f = 0; f < region.size(); ++f) {
-      if (!region[f]) continue;
-      const Triangle& t = mesh.triangles[f];
-      const double most = std::max({longest[static_cast<size_t>(t[0])], longest[static_cast<size_t>(t[1])],
-                                    longest[static_cast<size_t>(t[2])]});
-      for (int v : t) wider[static_cast<size_t>(v)] = std::max(wider[static_cast<size_t>(v)], most);
+    for (size_t i = 0; i < in_region.size(); ++i) {
+      const Triangle& t = mesh.triangles[in_region[i]];
+      most[i] = std::max({longest[static_cast<size_t>(t[0])], longest[static_cast<size_t>(t[1])],
+                          longest[static_cast<size_t>(t[2])]});
     }
-    longest.swap(wider);
+    for (size_t i = 0; i < in_region.size(); ++i)
+      for (int v : mesh.triangles[in_region[i]])
+        longest[static_cast<size_t>(v)] = std::max(longest[static_cast<size_t>(v)], most[i]);
   }
   return longest;
 }
@@ -522,12 +526,22 @@ void add_near_open_stars(const SurfaceMesh& mesh, const std::vector<signed char>
       it->second = std::max({it->second, (at(t[k]) - at(t[(k + 1) % 3])).norm(), (at(t[k]) - at(t[(k + 2) % 3])).norm()});
     }
   std::vector<int> near;  // the patch's and the context's vertices
+  Eigen::AlignedBox3d box;
   for (size_t v = 0; v < n; ++v)
-    if (role[v] != kNone) near.push_back(static_cast<int>(v));
+    if (role[v] != kNone) {
+      near.push_back(static_cast<int>(v));
+      box.extend(mesh.vertices[v]);
+    }
+  double widest = 0;
+  for (const auto& entry : longest) widest = std::max(widest, reach * entry.second);
+  if (near.empty() || !(widest > 0)) return;
+  const BoxGrid grid(mesh, near, box, widest);
   for (const auto& [v, edge] : longest) {
     const double r2 = reach * reach * edge * edge;
-    for (int w : near)
-      if ((at(w) - at(v)).squaredNorm() < r2) faults.push_back(w);
+    const Eigen::Vector3d& p = at(v);
+    grid.each_near(p, reach * edge, [&](int w, const Eigen::Vector3d& q) {
+      if ((q - p).squaredNorm() < r2) faults.push_back(w);
+    });
   }
 }
 
