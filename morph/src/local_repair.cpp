@@ -105,19 +105,24 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
 constexpr int kAttemptsBeforeGivingUp = 4;
 
 // Vertices in a box, sorted into cubic cells of one width held in one
-// array (a counting sort): built for each attempt of a patch from tens of
-// thousands of vertices, where hashing each into a PointGrid cost more
-// than the context search itself.
+// array by a counting sort, their positions beside them in cell order. It
+// is built for every attempt of a patch, from tens of thousands of
+// vertices: one array, where a hash of cells would cost more to fill than
+// the searches it serves.
 class BoxGrid {
  public:
-  // `cell` (Angstrom, > 0) widens so that there are at most a few cells a vertex.
+  // `cell` (Angstrom, > 0) widens until there are at most four cells a
+  // vertex (and 64 more).
   BoxGrid(const SurfaceMesh& mesh, const std::vector<int>& vertices, const Eigen::AlignedBox3d& box, double cell)
-      : mesh_(mesh), origin_(box.min()) {
+      : mesh_(mesh), origin_(box.min()), cell_(cell) {
     const double most_cells = 4.0 * static_cast<double>(vertices.size()) + 64;
-    const Eigen::Vector3d extent = box.sizes();
-    double cells = 1;
-    for (int k = 0; k < 3; ++k) cells *= std::floor(std::max(extent[k], 0.0) / cell) + 1;
-    cell_ = cells > most_cells ? cell * std::cbrt(cells / most_cells) : cell;
+    const Eigen::Vector3d extent = box.sizes().cwiseMax(0.0);
+    const auto cells_at = [&](double width) {
+      double cells = 1;
+      for (int k = 0; k < 3; ++k) cells *= std::floor(extent[k] / width) + 1;
+      return cells;
+    };
+    while (cells_at(cell_) > most_cells) cell_ *= 1.5;
     dims_ = ((extent / cell_).array().floor().cast<int>() + 1).cwiseMax(1);
     start_.assign(static_cast<size_t>(dims_.prod()) + 1, 0);
     for (int v : vertices) ++start_[index(cell_of(at(v))) + 1];
@@ -158,7 +163,7 @@ class BoxGrid {
   }
   const SurfaceMesh& mesh_;
   Eigen::Vector3d origin_;
-  double cell_ = 1;
+  double cell_;
   Eigen::Vector3i dims_;
   std::vector<int> start_, items_;
   std::vector<Eigen::Vector3d> points_;  // of items_, in their order: read together
