@@ -3,6 +3,7 @@
 // followed by a check of the KKT conditions against every ball; balls that
 // violate them join the candidates and the solve repeats.
 #include "skinmesh/core/skin_oracle.hpp"
+#include "skinmesh/core/cell_grid.hpp"
 #include "skinmesh/core/error.hpp"
 
 #include <Eigen/Dense>
@@ -11,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 namespace skinmesh {
@@ -27,25 +29,8 @@ double OracleResult::distance() const {
 // answer's certificate (SkinOracle::evaluate bounds the rest).
 class BallGrid {
  public:
-  explicit BallGrid(const std::vector<Ball>& balls) {
-    lower_ = upper_ = balls.front().center;
-    for (const Ball& b : balls) {
-      lower_ = lower_.cwiseMin(b.center);
-      upper_ = upper_.cwiseMax(b.center);
-      max_weight_ = std::max(max_weight_, b.weight);
-    }
-    const Eigen::Vector3d extent = (upper_ - lower_).cwiseMax(1e-9);
-    const double n = static_cast<double>(balls.size());
-    cell_ = std::max(std::cbrt(extent.prod() / n), 1e-3 * extent.maxCoeff());
-    for (int a = 0; a < 3; ++a) dims_[a] = std::min(1 + static_cast<int>(extent[a] / cell_), 1 << 10);
-    const size_t cells = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
-    start_.assign(cells + 1, 0);
-    std::vector<size_t> cell_of(balls.size());
-    for (size_t i = 0; i < balls.size(); ++i) ++start_[(cell_of[i] = cell_index(balls[i].center)) + 1];
-    for (size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
-    index_.resize(balls.size());
-    std::vector<size_t> fill(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < balls.size(); ++i) index_[fill[cell_of[i]]++] = static_cast<int>(i);
+  explicit BallGrid(const std::vector<Ball>& balls) : grid_(grid_of(balls)) {
+    for (const Ball& b : balls) max_weight_ = std::max(max_weight_, b.weight);
   }
   double max_weight() const { return max_weight_; }
   // Calls visit(i) for every ball whose centre lies within `radius` of x (and
@@ -53,41 +38,31 @@ class BallGrid {
   // most of the grid: the caller then passes over every ball.
   template <class Visit>
   bool within(const Eigen::Vector3d& x, double radius, Visit visit) const {
-    std::array<int, 3> from{}, to{};
-    double covered = 1;
-    for (int a = 0; a < 3; ++a) {
-      from[a] = cell_along(a, x[a] - radius);
-      to[a] = cell_along(a, x[a] + radius);
-      if (!(x[a] + radius >= lower_[a] - cell_ && x[a] - radius <= upper_[a] + cell_)) return true;  // none near
-      covered *= to[a] - from[a] + 1;
-    }
-    if (!(covered * 2 < static_cast<double>(start_.size()))) return false;
-    for (int i = from[0]; i <= to[0]; ++i)
-      for (int j = from[1]; j <= to[1]; ++j)
-        for (int k = from[2]; k <= to[2]; ++k) {
-          const size_t c = (static_cast<size_t>(i) * dims_[1] + j) * dims_[2] + k;
-          for (size_t e = start_[c]; e < start_[c + 1]; ++e) visit(index_[e]);
-        }
+    const std::optional<CellGrid::Cells> cells = grid_.cells_met(x, radius);
+    if (!cells) return !std::isnan(radius) && !std::isnan(x.sum());  // none near
+    if (!(cells->count() * 2 < grid_.cells())) return false;
+    grid_.any_in(*cells, [&](int i, const Eigen::Vector3d&) {
+      visit(i);
+      return false;
+    });
     return true;
   }
 
  private:
-  // Clamped in floating point before the cast: a far point or a huge radius
-  // must not overflow the integer.
-  int cell_along(int axis, double coordinate) const {
-    const double at = std::floor((coordinate - lower_[axis]) / cell_);
-    return static_cast<int>(std::clamp(std::isnan(at) ? 0.0 : at, 0.0, static_cast<double>(dims_[axis] - 1)));
+  // Cells as wide as the balls' mean spacing, at most four a ball.
+  static CellGrid grid_of(const std::vector<Ball>& balls) {
+    std::vector<Eigen::Vector3d> centers;
+    centers.reserve(balls.size());
+    Eigen::AlignedBox3d box;
+    for (const Ball& b : balls) box.extend(centers.emplace_back(b.center));
+    const Eigen::Vector3d extent = box.sizes().cwiseMax(1e-9);
+    CellGridOptions options;
+    options.cell = std::max(std::cbrt(extent.prod() / static_cast<double>(balls.size())), 1e-3 * extent.maxCoeff());
+    options.most_cells = 4.0 * static_cast<double>(balls.size()) + 64;
+    return CellGrid(std::move(centers), {}, box, options);
   }
-  size_t cell_index(const Eigen::Vector3d& p) const {
-    std::array<size_t, 3> at{};
-    for (int a = 0; a < 3; ++a) at[a] = static_cast<size_t>(cell_along(a, p[a]));
-    return (at[0] * dims_[1] + at[1]) * dims_[2] + at[2];
-  }
-  Eigen::Vector3d lower_, upper_;
-  double cell_ = 1, max_weight_ = -INFINITY;
-  std::array<int, 3> dims_{};
-  std::vector<size_t> start_;  // balls of cell c: index_[start_[c] .. start_[c+1])
-  std::vector<int> index_;
+  CellGrid grid_;
+  double max_weight_ = -INFINITY;
 };
 
 SkinOracle::SkinOracle(std::vector<Ball> balls, double shrink) : balls_(std::move(balls)), shrink_(shrink) {

@@ -3,6 +3,8 @@
 #include "judge.hpp"
 #include "mesh_part.hpp"
 
+#include "skinmesh/core/cell_grid.hpp"
+
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -104,70 +106,18 @@ double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
 // may give up for want of progress.
 constexpr int kAttemptsBeforeGivingUp = 4;
 
-// Vertices in a box, sorted into cubic cells of one width held in one
-// array by a counting sort, their positions beside them in cell order. It
-// is built for every attempt of a patch, from tens of thousands of
-// vertices: one array, where a hash of cells would cost more to fill than
-// the searches it serves.
-class BoxGrid {
- public:
-  // `cell` (Angstrom, > 0) widens until there are at most four cells a
-  // vertex (and 64 more).
-  BoxGrid(const SurfaceMesh& mesh, const std::vector<int>& vertices, const Eigen::AlignedBox3d& box, double cell)
-      : mesh_(mesh), origin_(box.min()), cell_(cell) {
-    const double most_cells = 4.0 * static_cast<double>(vertices.size()) + 64;
-    const Eigen::Vector3d extent = box.sizes().cwiseMax(0.0);
-    const auto cells_at = [&](double width) {
-      double cells = 1;
-      for (int k = 0; k < 3; ++k) cells *= std::floor(extent[k] / width) + 1;
-      return cells;
-    };
-    while (cells_at(cell_) > most_cells) cell_ *= 1.5;
-    dims_ = ((extent / cell_).array().floor().cast<int>() + 1).cwiseMax(1);
-    start_.assign(static_cast<size_t>(dims_.prod()) + 1, 0);
-    for (int v : vertices) ++start_[index(cell_of(at(v))) + 1];
-    for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
-    items_.resize(vertices.size());
-    points_.resize(vertices.size());
-    std::vector<int> fill(start_.begin(), start_.end() - 1);
-    for (int v : vertices) {
-      const auto q = static_cast<size_t>(fill[index(cell_of(at(v)))]++);
-      items_[q] = v;
-      points_[q] = at(v);
-    }
-  }
-  // Calls visit(v, point of v) for every vertex in the cells that the cube
-  // of half-width `radius` about p meets.
-  template <class Visit>
-  void each_near(const Eigen::Vector3d& p, double radius, Visit visit) const {
-    const Eigen::Vector3i lo = cell_of(p.array() - radius), hi = cell_of(p.array() + radius);
-    for (int i = lo.x(); i <= hi.x(); ++i)
-      for (int j = lo.y(); j <= hi.y(); ++j)
-        for (int k = lo.z(); k <= hi.z(); ++k) {
-          const size_t at_cell = index({i, j, k});
-          for (int q = start_[at_cell]; q < start_[at_cell + 1]; ++q)
-            visit(items_[static_cast<size_t>(q)], points_[static_cast<size_t>(q)]);
-        }
-  }
-
- private:
-  const Eigen::Vector3d& at(int v) const { return mesh_.vertices[static_cast<size_t>(v)]; }
-  Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
-    const Eigen::Vector3i c = ((p - origin_) / cell_).array().floor().cast<int>();
-    return c.cwiseMax(0).cwiseMin(dims_ - Eigen::Vector3i::Ones());
-  }
-  size_t index(const Eigen::Vector3i& c) const {
-    return (static_cast<size_t>(c.x()) * static_cast<size_t>(dims_.y()) + static_cast<size_t>(c.y())) *
-               static_cast<size_t>(dims_.z()) +
-           static_cast<size_t>(c.z());
-  }
-  const SurfaceMesh& mesh_;
-  Eigen::Vector3d origin_;
-  double cell_;
-  Eigen::Vector3i dims_;
-  std::vector<int> start_, items_;
-  std::vector<Eigen::Vector3d> points_;  // of items_, in their order: read together
-};
+// `vertices` of the mesh in cubic cells over `box`, `cell` (Angstrom)
+// wide or wider: at most four cells a vertex (and 64 more). Built for
+// every attempt of a patch, from tens of thousands of vertices.
+CellGrid grid_of_vertices(const SurfaceMesh& mesh, std::vector<int> vertices, const Eigen::AlignedBox3d& box,
+                          double cell) {
+  std::vector<Eigen::Vector3d> points(vertices.size());
+  for (size_t k = 0; k < vertices.size(); ++k) points[k] = mesh.vertices[static_cast<size_t>(vertices[k])];
+  CellGridOptions options;
+  options.cell = cell;
+  options.most_cells = 4.0 * static_cast<double>(vertices.size()) + 64;
+  return CellGrid(std::move(points), std::move(vertices), box, options);
+}
 
 // Vertices near the patch that the mesh does not join to it (another sheet
 // across a thin gap, the far side of a narrow neck) become context too.
@@ -214,7 +164,7 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   // Grid cells half as wide as the median reach: most vertices search
   // 27-64 cells, about 3-8 times the volume of their ball.
   std::nth_element(reaches.begin(), reaches.begin() + static_cast<long>(reaches.size() / 2), reaches.end());
-  const BoxGrid grid(mesh, outside, near_box, 0.5 * reaches[reaches.size() / 2]);
+  const CellGrid grid = grid_of_vertices(mesh, std::move(outside), near_box, 0.5 * reaches[reaches.size() / 2]);
   size_t taken = static_cast<size_t>(std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; }));
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and the list could outgrow
@@ -540,7 +490,7 @@ void add_near_open_stars(const SurfaceMesh& mesh, const std::vector<signed char>
   double widest = 0;
   for (const auto& entry : longest) widest = std::max(widest, reach * entry.second);
   if (near.empty() || !(widest > 0)) return;
-  const BoxGrid grid(mesh, near, box, widest);
+  const CellGrid grid = grid_of_vertices(mesh, std::move(near), box, widest);
   for (const auto& [v, edge] : longest) {
     const double r2 = reach * reach * edge * edge;
     const Eigen::Vector3d& p = at(v);

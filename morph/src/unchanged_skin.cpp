@@ -1,7 +1,7 @@
 #include "unchanged_skin.hpp"
 
+#include "skinmesh/core/cell_grid.hpp"
 #include "skinmesh/core/error.hpp"
-#include "skinmesh/core/point_grid.hpp"
 
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace skinmesh::detail {
 
@@ -68,101 +69,6 @@ double inactive_beyond(double s, double rho, double g, double weight, double f0,
   return std::max(rho, (half_b + std::sqrt(half_b * half_b + s * c)) / s);
 }
 
-// The places in cubic cells over their bounding box, each cell's places in
-// one run (`first`), with a summed table of the counts: how many places
-// lie in the cells a box meets is a constant-time question.
-class PlaceGrid {
- public:
-  PlaceGrid(const std::vector<Place>& places, double cell) : cell_(cell) {
-    low_ = places.front().center;
-    Eigen::Vector3d high = low_;
-    for (const Place& p : places) {
-      low_ = low_.cwiseMin(p.center);
-      high = high.cwiseMax(p.center);
-    }
-    for (int k = 0; k < 3; ++k) size_[k] = static_cast<int>(std::floor((high[k] - low_[k]) / cell_)) + 1;
-    const size_t cells = static_cast<size_t>(size_[0]) * static_cast<size_t>(size_[1]) * static_cast<size_t>(size_[2]);
-    first_.assign(cells + 1, 0);
-    std::vector<size_t> at(places.size());
-    for (size_t k = 0; k < places.size(); ++k) {
-      at[k] = index(clamped(places[k].center));
-      ++first_[at[k] + 1];
-    }
-    for (size_t c = 0; c < cells; ++c) first_[c + 1] += first_[c];
-    items_.resize(places.size());
-    std::vector<int> fill(first_.begin(), first_.end() - 1);
-    for (size_t k = 0; k < places.size(); ++k) items_[static_cast<size_t>(fill[at[k]]++)] = static_cast<int>(k);
-    // sums_(i, j, k): the places in cells [0, i) x [0, j) x [0, k).
-    sums_.assign(static_cast<size_t>(size_[0] + 1) * static_cast<size_t>(size_[1] + 1) * static_cast<size_t>(size_[2] + 1), 0);
-    for (int i = 1; i <= size_[0]; ++i)
-      for (int j = 1; j <= size_[1]; ++j)
-        for (int k = 1; k <= size_[2]; ++k) {
-          const size_t c = index({i - 1, j - 1, k - 1});
-          sum(i, j, k) = (first_[c + 1] - first_[c]) + sum(i - 1, j, k) + sum(i, j - 1, k) + sum(i, j, k - 1) -
-                         sum(i - 1, j - 1, k) - sum(i - 1, j, k - 1) - sum(i, j - 1, k - 1) + sum(i - 1, j - 1, k - 1);
-        }
-  }
-  // Whether any place lies in a cell that the cube of half-width r about x meets.
-  bool any_within(const Eigen::Vector3d& x, double r) const {
-    Eigen::Vector3i lo, hi;
-    return cells_met(x, r, lo, hi) && count(lo, hi) > 0;
-  }
-  // Calls visit(place index) for the places in the cells the cube meets,
-  // until it returns true; returns whether it did. A row of cells holds
-  // its places in one run.
-  template <class Visit>
-  bool any_of(const Eigen::Vector3d& x, double r, Visit visit) const {
-    Eigen::Vector3i lo, hi;
-    if (!cells_met(x, r, lo, hi)) return false;
-    for (int i = lo[0]; i <= hi[0]; ++i)
-      for (int j = lo[1]; j <= hi[1]; ++j) {
-        for (int m = first_[index({i, j, lo[2]})], end = first_[index({i, j, hi[2]}) + 1]; m < end; ++m)
-          if (visit(items_[static_cast<size_t>(m)])) return true;
-      }
-    return false;
-  }
-
- private:
-  Eigen::Vector3i clamped(const Eigen::Vector3d& p) const {
-    Eigen::Vector3i c;
-    for (int k = 0; k < 3; ++k)
-      c[k] = static_cast<int>(std::clamp(std::floor((p[k] - low_[k]) / cell_), 0.0, static_cast<double>(size_[k] - 1)));
-    return c;
-  }
-  // The cells the cube of half-width r about x meets, clamped to the grid; false when none.
-  bool cells_met(const Eigen::Vector3d& x, double r, Eigen::Vector3i& lo, Eigen::Vector3i& hi) const {
-    for (int k = 0; k < 3; ++k) {
-      const double a = std::floor((x[k] - r - low_[k]) / cell_), b = std::floor((x[k] + r - low_[k]) / cell_);
-      if (b < 0 || a > size_[k] - 1) return false;
-      lo[k] = static_cast<int>(std::max(a, 0.0));
-      hi[k] = static_cast<int>(std::min(b, static_cast<double>(size_[k] - 1)));
-    }
-    return true;
-  }
-  // The places in cells lo..hi (inclusive) from the summed table.
-  int count(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) const {
-    const int a0 = lo[0], a1 = lo[1], a2 = lo[2], b0 = hi[0] + 1, b1 = hi[1] + 1, b2 = hi[2] + 1;
-    return sum(b0, b1, b2) - sum(a0, b1, b2) - sum(b0, a1, b2) - sum(b0, b1, a2) + sum(a0, a1, b2) + sum(a0, b1, a2) +
-           sum(b0, a1, a2) - sum(a0, a1, a2);
-  }
-  size_t index(const Eigen::Vector3i& c) const {
-    return (static_cast<size_t>(c[0]) * static_cast<size_t>(size_[1]) + static_cast<size_t>(c[1])) *
-               static_cast<size_t>(size_[2]) +
-           static_cast<size_t>(c[2]);
-  }
-  int& sum(int i, int j, int k) {
-    return sums_[(static_cast<size_t>(i) * static_cast<size_t>(size_[1] + 1) + static_cast<size_t>(j)) *
-                     static_cast<size_t>(size_[2] + 1) +
-                 static_cast<size_t>(k)];
-  }
-  int sum(int i, int j, int k) const { return const_cast<PlaceGrid*>(this)->sum(i, j, k); }
-
-  double cell_;
-  Eigen::Vector3d low_;
-  std::array<int, 3> size_{};
-  std::vector<int> first_, items_, sums_;
-};
-
 }  // namespace
 
 // MATH.md section 2: F(x) = min over l in the simplex of
@@ -209,14 +115,20 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
   const double g_most = std::sqrt(std::max((s * heaviest_of_all + kOffSkin) / (1 - s), 0.0)) + kOffSkin;
   Eigen::AlignedBox3d span;
   for (const Place& p : places) span.extend(p.center);
-  const PlaceGrid grid(places, std::max(kCell, span.sizes().maxCoeff() / kMostCellsAcross));
+  std::vector<Eigen::Vector3d> centers(places.size());
+  for (size_t k = 0; k < places.size(); ++k) centers[k] = places[k].center;
+  CellGridOptions grid_options;
+  grid_options.cell = std::max(kCell, span.sizes().maxCoeff() / kMostCellsAcross);
+  grid_options.counts = true;  // "any place near?" in constant time
+  const CellGrid grid(std::move(centers), {}, span, grid_options);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, unchanged.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       if (!candidates[v] || !std::isfinite(radius[v])) continue;
       const Eigen::Vector3d& x0 = mesh.vertices[v];
       const double rho = radius[v];
       // No place within the bound's reach for the most g can be: no need to evaluate F.
-      if (!grid.any_within(x0, inactive_beyond(s, rho, g_most, heaviest, kOffSkin, kOffSkin))) {
+      const std::optional<CellGrid::Cells> worst = grid.cells_met(x0, inactive_beyond(s, rho, g_most, heaviest, kOffSkin, kOffSkin));
+      if (!worst || grid.count_in(*worst) == 0) {
         unchanged[v] = 1;
         continue;
       }
@@ -226,7 +138,7 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
       const double lost = std::max(e.value, 0.0) + grad * rho + rho * rho;
       const double reach = inactive_beyond(s, rho, 0.5 * grad, heaviest, e.value, kOffSkin);
       if (!std::isfinite(reach)) continue;  // unproven
-      unchanged[v] = !grid.any_of(x0, reach, [&](int k) {
+      unchanged[v] = !grid.any_near(x0, reach, [&](int k, const Eigen::Vector3d&) {
         const Place& p = places[static_cast<size_t>(k)];
         const double d = (p.center - x0).norm();
         if (!(d > rho)) return true;
