@@ -1,7 +1,8 @@
 // Items placed at points, hashed into cubic cells of one width, for the
 // question "which items lie within r of p" when r spans a few cells: a
-// lookup scans the cells around p's. Used by the morph's local patch (its
-// context) and the mesher's patch mode (how near the patch a crossing is).
+// lookup scans the cells around p's. Used by the mesher's patch mode (how
+// near the patch a crossing is), whose items arrive one by one; a fixed
+// set is better served by CellGrid (cell_grid.hpp).
 #pragma once
 
 #include <Eigen/Core>
