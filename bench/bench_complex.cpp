@@ -1,11 +1,14 @@
 // Reading and skin-complex construction, side by side with CGAL's own
 // Skin_surface_3 construction (regular triangulation + triangulated mixed
-// complex) on the same balls. Each measurement runs in a forked child, so the
+// complex) on the same balls, and the skin's topology counted from the
+// weighted alpha complex (skin_topology: the certificate every mesh and
+// morph frame is checked against). Each measurement runs in a forked child, so the
 // peak memory reported is that task's own.
 //
 //   bench_complex [--repeat N] [FILE...]     (default: data/1hpv.pdb and data/3mht.pdb)
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Skin_surface_3.h>
@@ -82,13 +85,13 @@ int main(int argc, char** argv) {
     std::string file;
     long atoms;
     long cells;
-    Measure read, complex, cgal;
+    Measure read, complex, cgal, topology;
   };
   std::vector<Row> rows;
   for (const std::string& file : files) {
     const Molecule m = read_molecule(file);
     const auto balls = balls_from_molecule(m, s);
-    Row row{file, static_cast<long>(m.atoms.size()), 0, {}, {}, {}};
+    Row row{file, static_cast<long>(m.atoms.size()), 0, {}, {}, {}, {}};
     row.read = run_in_child(repeat, [&] { return static_cast<long>(read_molecule(file).atoms.size()); });
     row.complex = run_in_child(repeat, [&] { return static_cast<long>(build_skin_complex(balls, {s}).cells().size()); });
     row.cells = row.complex.count;
@@ -99,21 +102,24 @@ int main(int argc, char** argv) {
       CGAL::Skin_surface_3<CGAL::Skin_surface_traits_3<K>> skin(wp.begin(), wp.end(), s, false);
       return static_cast<long>(skin.triangulated_mixed_complex().number_of_cells());
     });
+    row.topology = run_in_child(repeat, [&] { return skin_topology(balls).euler; });
     std::printf(
         "{\"file\": \"%s\", \"atoms\": %ld, \"repeat\": %d, \"read_seconds\": %.6f, \"read_peak_mb\": %.1f, "
         "\"mixed_cells\": %ld, \"complex_seconds\": %.6f, \"complex_peak_mb\": %.1f, "
-        "\"cgal_skin_surface_3_seconds\": %.6f, \"cgal_peak_mb\": %.1f, \"cgal_tmc_cells\": %ld}\n",
+        "\"cgal_skin_surface_3_seconds\": %.6f, \"cgal_peak_mb\": %.1f, \"cgal_tmc_cells\": %ld, "
+        "\"topology_seconds\": %.6f, \"topology_peak_mb\": %.1f}\n",
         file.c_str(), row.atoms, repeat, row.read.seconds, row.read.peak_mb, row.cells, row.complex.seconds,
-        row.complex.peak_mb, row.cgal.seconds, row.cgal.peak_mb, row.cgal.count);
+        row.complex.peak_mb, row.cgal.seconds, row.cgal.peak_mb, row.cgal.count, row.topology.seconds,
+        row.topology.peak_mb);
     std::fflush(stdout);
     rows.push_back(row);
   }
-  std::printf("\n| file | atoms | read s | mixed cells | complex s | complex peak MB | CGAL Skin_surface_3 s | CGAL peak MB |\n");
-  std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::printf("\n| file | atoms | read s | mixed cells | complex s | complex peak MB | CGAL Skin_surface_3 s | CGAL peak MB | topology s |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& r : rows) {
     const std::string name = r.file.substr(r.file.find_last_of('/') + 1);
-    std::printf("| %s | %ld | %.4f | %ld | %.4f | %.1f | %.3f | %.1f |\n", name.c_str(), r.atoms, r.read.seconds, r.cells,
-                r.complex.seconds, r.complex.peak_mb, r.cgal.seconds, r.cgal.peak_mb);
+    std::printf("| %s | %ld | %.4f | %ld | %.4f | %.1f | %.3f | %.1f | %.4f |\n", name.c_str(), r.atoms, r.read.seconds,
+                r.cells, r.complex.seconds, r.complex.peak_mb, r.cgal.seconds, r.cgal.peak_mb, r.topology.seconds);
   }
   return 0;
 }

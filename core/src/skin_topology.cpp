@@ -12,20 +12,26 @@
 #include <CGAL/Fixed_alpha_shape_cell_base_3.h>
 #include <CGAL/Fixed_alpha_shape_vertex_base_3.h>
 #include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numeric>
 
 namespace skinmesh {
 namespace {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Fixed_alpha_shape_vertex_base_3<K, CGAL::Regular_triangulation_vertex_base_3<K>>;
-using Cb = CGAL::Fixed_alpha_shape_cell_base_3<K, CGAL::Regular_triangulation_cell_base_3<K>>;
+// Each vertex and cell holds its index among those counted (-1: not
+// counted): a look-up per edge and per neighbour, where a map of handles
+// cost as much as the alpha shape's own classification.
+using Vb = CGAL::Fixed_alpha_shape_vertex_base_3<
+    K, CGAL::Triangulation_vertex_base_with_info_3<long, K, CGAL::Regular_triangulation_vertex_base_3<K>>>;
+using Cb = CGAL::Fixed_alpha_shape_cell_base_3<
+    K, CGAL::Triangulation_cell_base_with_info_3<long, K, CGAL::Regular_triangulation_cell_base_3<K>>>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
 using Regular = CGAL::Regular_triangulation_3<K, Tds>;
 using AlphaShape = CGAL::Fixed_alpha_shape_3<Regular>;
@@ -43,21 +49,24 @@ struct UnionFind {
 // Components of the body's complement: tetrahedra outside K joined through
 // triangles outside K (a lower face outside K has every coface outside K),
 // every infinite cell one unbounded region. Returns the bounded ones.
-long count_voids(const AlphaShape& shape) {
+long count_voids(AlphaShape& shape) {
   if (shape.dimension() < 3) return 0;  // flat or fewer than four balls: nothing is enclosed
-  std::map<AlphaShape::Cell_handle, long> index;
-  for (auto c = shape.all_cells_begin(); c != shape.all_cells_end(); ++c)
-    if (shape.is_infinite(c) || shape.classify(c) == AlphaShape::EXTERIOR) index.emplace(c, static_cast<long>(index.size()));
-  const long outside = static_cast<long>(index.size());  // the unbounded region
-  UnionFind regions(index.size() + 1);
-  for (const auto& [cell, i] : index) {
+  std::vector<AlphaShape::Cell_handle> outside_cells;
+  for (auto c = shape.all_cells_begin(); c != shape.all_cells_end(); ++c) {
+    const bool outside = shape.is_infinite(c) || shape.classify(c) == AlphaShape::EXTERIOR;
+    c->info() = outside ? static_cast<long>(outside_cells.size()) : -1;
+    if (outside) outside_cells.push_back(c);
+  }
+  const long outside = static_cast<long>(outside_cells.size());  // the unbounded region
+  UnionFind regions(outside_cells.size() + 1);
+  for (long i = 0; i < outside; ++i) {
+    const AlphaShape::Cell_handle cell = outside_cells[static_cast<size_t>(i)];
     if (shape.is_infinite(cell)) regions.join(i, outside);
     for (int k = 0; k < 4; ++k) {
-      const auto other = cell->neighbor(k);
-      const auto found = index.find(other);
-      if (found == index.end()) continue;
+      const long other = cell->neighbor(k)->info();
+      if (other < 0) continue;
       const bool facet_outside = shape.is_infinite(cell, k) || shape.classify(AlphaShape::Facet(cell, k)) == AlphaShape::EXTERIOR;
-      if (facet_outside) regions.join(i, found->second);
+      if (facet_outside) regions.join(i, other);
     }
   }
   long voids = 0;
@@ -99,17 +108,18 @@ SkinTopology skin_topology(const std::vector<Ball>& balls) {
     const Eigen::Vector3d x = mid + far * corner;
     points.emplace_back(K::Point_3(x.x(), x.y(), x.z()), -1.0);
   }
-  const AlphaShape shape(points.begin(), points.end(), 0);
+  AlphaShape shape(points.begin(), points.end(), 0);
   // Every simplex of K counts (-1)^dim towards the body's Euler characteristic.
   long vertices = 0, edges = 0, triangles = 0, tetrahedra = 0;
-  std::map<AlphaShape::Vertex_handle, long> vertex_index;
   for (auto v = shape.finite_vertices_begin(); v != shape.finite_vertices_end(); ++v)
-    if (shape.classify(v) != AlphaShape::EXTERIOR) vertex_index.emplace(v, vertices++);
+    v->info() = shape.classify(v) != AlphaShape::EXTERIOR ? vertices++ : -1;
   UnionFind pieces(static_cast<size_t>(vertices));
   for (auto e = shape.finite_edges_begin(); e != shape.finite_edges_end(); ++e) {
     if (shape.classify(*e) == AlphaShape::EXTERIOR) continue;
     ++edges;
-    pieces.join(vertex_index.at(e->first->vertex(e->second)), vertex_index.at(e->first->vertex(e->third)));
+    const long from = e->first->vertex(e->second)->info(), to = e->first->vertex(e->third)->info();
+    if (from < 0 || to < 0) contract_error("skin_topology: an edge of the alpha complex has an end outside it");
+    pieces.join(from, to);
   }
   for (auto f = shape.finite_facets_begin(); f != shape.finite_facets_end(); ++f)
     triangles += shape.classify(*f) != AlphaShape::EXTERIOR;
