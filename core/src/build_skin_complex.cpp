@@ -279,8 +279,7 @@ struct SkinComplexBuilder {
     for (int i = 0; i < n; ++i)
       if (sc.vertex_cell_[static_cast<size_t>(i)] < 0) sc.hidden_.push_back(i);
     // The tuple -> cell lookup (find_cell).
-    sc.cell_of_balls_.reserve(cells.size() * 2);
-    for (size_t i = 0; i < cells.size(); ++i) sc.cell_of_balls_.emplace(cells[i].balls, static_cast<int>(i));
+    sc.index_cells();
   }
 
   // Faces (drop one ball) and cofaces (add one ball) of every cell, in CSR form.

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <cstdint>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -89,9 +90,36 @@ int SkinComplex::owning_ball(const Eigen::Vector3d& x, int cell) const {
   return best;
 }
 
+// The four ids folded into 64 bits, then splitmix64's finaliser (Steele,
+// Lea and Flood 2014), whose low bits depend on every input bit: the mask
+// keeps only low bits, and nearby ball ids must not crowd one run of slots.
+size_t SkinComplex::slot_of(const std::array<int, 4>& tuple) const {
+  uint64_t h = 0;
+  for (int v : tuple) h = h * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(static_cast<uint32_t>(v));
+  h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
+  h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
+  h ^= h >> 31;
+  return static_cast<size_t>(h) & (cell_table_.size() - 1);
+}
+
+void SkinComplex::index_cells() {
+  size_t size = 16;
+  while (size < 2 * cells_.size()) size *= 2;
+  cell_table_.assign(size, -1);
+  for (size_t c = 0; c < cells_.size(); ++c) {
+    size_t at = slot_of(cells_[c].balls);
+    while (cell_table_[at] >= 0) at = (at + 1) & (size - 1);
+    cell_table_[at] = static_cast<int>(c);
+  }
+}
+
 int SkinComplex::find_cell(std::array<int, 4> balls) const {
-  const auto it = cell_of_balls_.find(ball_tuple(balls));
-  return it == cell_of_balls_.end() ? -1 : it->second;
+  if (cell_table_.empty()) return -1;
+  const std::array<int, 4> tuple = ball_tuple(balls);
+  for (size_t at = slot_of(tuple);; at = (at + 1) & (cell_table_.size() - 1)) {
+    const int c = cell_table_[at];
+    if (c < 0 || cells_[static_cast<size_t>(c)].balls == tuple) return c;
+  }
 }
 
 std::array<int, 4> SkinComplex::ball_tuple(std::array<int, 4> ids) {

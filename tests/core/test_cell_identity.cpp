@@ -32,6 +32,15 @@ TEST_CASE("find_cell: every cell is found by its ball tuple, in any order", "[co
         (balls[static_cast<size_t>(far)].center - balls[0].center).norm())
       far = b;
   CHECK(complex.find_cell({0, far, -1, -1}) == -1);
+  // Every pair with ball 0: found exactly when some edge cell joins them.
+  for (int b = 1; b < static_cast<int>(balls.size()); ++b) {
+    const bool edge = std::any_of(complex.cells().begin(), complex.cells().end(), [&](const MixedCell& cell) {
+      return cell.dim == 1 && cell.balls[0] == 0 && cell.balls[1] == b;
+    });
+    const int found = complex.find_cell({b, 0, -1, -1});
+    REQUIRE((found >= 0) == edge);
+    if (found >= 0) CHECK(complex.cell(found).balls == std::array<int, 4>{0, b, -1, -1});
+  }
 }
 
 TEST_CASE("a point's cell survives rebuilding the complex from permuted balls", "[complex][identity]") {

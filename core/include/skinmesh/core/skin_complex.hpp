@@ -16,7 +16,6 @@
 
 #include <array>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 namespace skinmesh {
@@ -195,14 +194,13 @@ class SkinComplex {
   std::vector<int> face_offset_, faces_;
   std::vector<int> coface_offset_;
   std::vector<Coface> cofaces_;
-  struct BallTupleHash {
-    size_t operator()(const std::array<int, 4>& k) const {
-      size_t h = 1469598103934665603ull;  // FNV-1a over the four ids
-      for (int v : k) h = (h ^ static_cast<size_t>(v + 1)) * 1099511628211ull;
-      return h;
-    }
-  };
-  std::unordered_map<std::array<int, 4>, int, BallTupleHash> cell_of_balls_;  // ball tuple -> cell (find_cell)
+  // find_cell's table: open addressing with linear probing, a power of
+  // two at least twice the cells long, each slot a cell index (-1: empty)
+  // whose key is that cell's ball tuple in cells_. One array: a node per
+  // cell cost milliseconds to allocate and to free with every complex.
+  void index_cells();
+  size_t slot_of(const std::array<int, 4>& tuple) const;
+  std::vector<int> cell_table_;
   // Uniform grid over the centres of the non-hidden balls: a start for walks.
   Eigen::Vector3d grid_origin_ = Eigen::Vector3d::Zero();
   double grid_step_ = 1.0;
