@@ -72,11 +72,7 @@ std::optional<CellGrid::Cells> CellGrid::cells_met(const Eigen::Vector3d& x, dou
 void CellGrid::sum_counts() {
   const Eigen::Vector3i d = dims_ + Eigen::Vector3i::Ones();
   sums_.assign(static_cast<size_t>(d.prod()), 0);
-  const auto at = [&](int i, int j, int k) -> int& {
-    return sums_[(static_cast<size_t>(i) * static_cast<size_t>(d.y()) + static_cast<size_t>(j)) *
-                     static_cast<size_t>(d.z()) +
-                 static_cast<size_t>(k)];
-  };
+  const auto at = [&](int i, int j, int k) -> int& { return sums_[sum_index(i, j, k)]; };
   for (int i = 1; i < d.x(); ++i)
     for (int j = 1; j < d.y(); ++j)
       for (int k = 1; k < d.z(); ++k) {
@@ -86,11 +82,13 @@ void CellGrid::sum_counts() {
       }
 }
 
-int CellGrid::sum(int i, int j, int k) const {
-  return sums_[(static_cast<size_t>(i) * static_cast<size_t>(dims_.y() + 1) + static_cast<size_t>(j)) *
-                   static_cast<size_t>(dims_.z() + 1) +
-               static_cast<size_t>(k)];
+size_t CellGrid::sum_index(int i, int j, int k) const {
+  return (static_cast<size_t>(i) * static_cast<size_t>(dims_.y() + 1) + static_cast<size_t>(j)) *
+             static_cast<size_t>(dims_.z() + 1) +
+         static_cast<size_t>(k);
 }
+
+int CellGrid::sum(int i, int j, int k) const { return sums_[sum_index(i, j, k)]; }
 
 // Inclusion-exclusion over the summed table's eight corners.
 int CellGrid::count_in(const Cells& cells) const {

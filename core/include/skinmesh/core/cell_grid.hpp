@@ -83,6 +83,7 @@ class CellGrid {
   }
   Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const;
   void sum_counts();
+  size_t sum_index(int i, int j, int k) const;  // in sums_, whose sides are dims_ + 1
   int sum(int i, int j, int k) const;
 
   Eigen::Vector3d origin_;
