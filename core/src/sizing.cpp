@@ -12,8 +12,11 @@ double local_length(const SkinComplex& complex, const Eigen::Vector3d& x, int ce
 }
 
 double target_size(const SkinComplex& complex, const Eigen::Vector3d& x, int cell, const SizingOptions& options) {
-  const double size = options.epsilon * local_length(complex, x, cell);
-  return std::clamp(size, options.min_size, options.max_size);
+  return size_for_length(local_length(complex, x, cell), options);
+}
+
+double size_for_length(double length, const SizingOptions& options) {
+  return std::clamp(options.epsilon * length, options.min_size, options.max_size);
 }
 
 }  // namespace skinmesh

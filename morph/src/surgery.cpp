@@ -197,9 +197,13 @@ class Editor {
     unsigned char bits = 0;
     const Triangle& t = mesh_.triangles[f];
     for (size_t k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      if (a < b && (near[static_cast<size_t>(a)] || near[static_cast<size_t>(b)]) &&
-          (at(a) - at(b)).norm() < options_.thin_below * std::min(target_of(a), target_of(b)))
+      int a = t[k], b = t[(k + 1) % 3];
+      if (a > b || !(near[static_cast<size_t>(a)] || near[static_cast<size_t>(b)])) continue;
+      // The end near a change first: its target is known, and most edges
+      // are too long for it, so the other end's is rarely needed.
+      if (!near[static_cast<size_t>(a)]) std::swap(a, b);
+      const double length = (at(a) - at(b)).norm();
+      if (length < options_.thin_below * target_of(a) && length < options_.thin_below * target_of(b))
         bits = static_cast<unsigned char>(bits | (1u << k));
     }
     return bits;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 using namespace skinmesh;
 
@@ -87,4 +88,8 @@ TEST_CASE("target size follows curvature and respects its clamps", "[curvature][
   o.max_size = 3;
   o.min_size = 0.5;
   CHECK(target_size(sc, x, sc.locate(x), o) == Approx(0.5));
+  CHECK(size_for_length(1.0, o) == target_size(sc, x, sc.locate(x), o));
+  o.min_size = 0.05;
+  CHECK(size_for_length(0.5, o) == Approx(0.15));
+  CHECK(size_for_length(std::numeric_limits<double>::infinity(), o) == o.max_size);
 }

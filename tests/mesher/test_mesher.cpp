@@ -108,6 +108,36 @@ std::vector<Ball> molecule_balls(const std::string& path) {
 
 }  // namespace
 
+TEST_CASE("target edge length: the clamped curvature size, with no floor on sphere patches", "[mesher][sizing]") {
+  // Two balls whose skin has a neck (a hyperboloid of an edge cell) and two
+  // caps (sphere patches of vertex cells); radius sqrt(0.5 * 2) = 1 each.
+  const SkinComplex sc = build_skin_complex({{{0, 0, 0}, 2.0}, {{2.2, 0, 0}, 2.0}}, {0.5});
+  const Eigen::Vector3d cap(-1.0, 0, 0);
+  const int cap_cell = sc.locate(cap);
+  REQUIRE(sc.cell(cap_cell).dim == 0);
+  const Projection neck = sc.project({1.1, 0.5, 0}, sc.locate({1.1, 0.5, 0}), 1e-14);
+  REQUIRE(neck.converged);
+  REQUIRE(sc.cell(neck.cell).dim == 1);
+  MeshingOptions o;
+  o.sizing.epsilon = 0.3;
+  CHECK(target_edge_length(sc, cap, cap_cell, o) == Approx(0.3));
+  const double neck_size = 0.3 * local_length(sc, neck.point, neck.cell);
+  CHECK(target_edge_length(sc, neck.point, neck.cell, o) == Approx(neck_size));
+  // A floor above both: the neck takes it, the sphere cap does not.
+  o.sizing.min_size = 2 * std::max(0.3, neck_size);
+  CHECK(target_edge_length(sc, cap, cap_cell, o) == Approx(0.3));
+  CHECK(target_edge_length(sc, neck.point, neck.cell, o) == Approx(o.sizing.min_size));
+  // A ceiling and a requested edge length apply everywhere.
+  o.sizing.min_size = 0.01;
+  o.sizing.max_size = 0.02;
+  CHECK(target_edge_length(sc, cap, cap_cell, o) == Approx(0.02));
+  CHECK(target_edge_length(sc, neck.point, neck.cell, o) == Approx(0.02));
+  o.sizing.max_size = 3;
+  o.edge_length = 0.015;
+  CHECK(target_edge_length(sc, cap, cap_cell, o) == Approx(0.015));
+  CHECK(target_edge_length(sc, neck.point, neck.cell, o) == Approx(0.015));
+}
+
 TEST_CASE("mesher guarantees on the shipped molecules", "[mesher][large]") {
   for (const char* name : {"pept.pdb", "3al1.pdb", "1ubi.pdb"}) check_mesher_guarantees(molecule_balls(data_file(name)), name);
 }

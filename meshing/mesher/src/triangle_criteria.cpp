@@ -100,14 +100,17 @@ double target_edge_length(const SkinComplex& complex, const Eigen::Vector3d& x, 
   // with respect to the local radius of curvature sees every handle and
   // neck); a requested edge length can only make triangles smaller. A
   // strictly uniform 1 A mesh of 1ubi loses one of its 68 handles.
-  double base = target_size(complex, x, cell, options.sizing);
+  // One curvature evaluation for both sizes below: this runs for every
+  // triangle a frame judges.
+  const double length = local_length(complex, x, cell);
+  double base = size_for_length(length, options.sizing);
   if (options.edge_length > 0) base = std::min(base, options.edge_length);
   // Sphere patches (vertex and tetrahedron cells) have constant curvature, so
   // they need no floor against runaway refinement; without one, a tiny void
   // (a concave sphere a thousandth of an Angstrom across, which real proteins
   // have) is meshed as the closed component it is instead of one lost sample.
   const int dim = complex.cell(cell).dim;
-  if (dim == 0 || dim == 3) return std::min(base, options.sizing.epsilon * local_length(complex, x, cell));
+  if (dim == 0 || dim == 3) return std::min(base, options.sizing.epsilon * length);
   return base;
 }
 

@@ -19,5 +19,7 @@ double local_length(const SkinComplex& complex, const Eigen::Vector3d& x, int ce
 
 // epsilon * local_length, clamped to [min_size, max_size] (Angstrom).
 double target_size(const SkinComplex& complex, const Eigen::Vector3d& x, int cell, const SizingOptions& options);
+// The same for a local length already known (Angstrom).
+double size_for_length(double length, const SizingOptions& options);
 
 }  // namespace skinmesh
