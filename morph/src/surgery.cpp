@@ -103,6 +103,26 @@ class EdgeIndex {
   std::vector<std::pair<int, int>> slots_;  // (to, triangle)
 };
 
+// The triangles or vertices around one vertex, kept on the stack: the
+// thinning asks for four such lists for each edge it tries, and a heap
+// list each was a fifth of a small frame's time. A vertex with more
+// triangles than this is left alone by the edits.
+constexpr size_t kMostFan = 64;
+template <class T>
+class Fan {
+ public:
+  bool full() const { return size_ == kMostFan; }
+  void push_back(const T& x) { items_[size_++] = x; }
+  size_t size() const { return size_; }
+  const T* begin() const { return items_.data(); }
+  const T* end() const { return items_.data() + size_; }
+  const T& operator[](size_t k) const { return items_[k]; }
+
+ private:
+  std::array<T, kMostFan> items_;
+  size_t size_ = 0;
+};
+
 double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d u = (a - apex).normalized(), w = (b - apex).normalized();
   return std::acos(std::clamp(u.dot(w), -1.0, 1.0));
@@ -169,10 +189,10 @@ class Editor {
     return true;
   }
   // The triangles around v, in order across the edges into v (none where
-  // they are not one closed fan of at most 64).
-  std::vector<int> star(int v) const;
+  // they are not one closed fan of at most kMostFan).
+  Fan<int> star(int v) const;
   // The vertices around v, in the same order (the corner after v in each triangle).
-  std::vector<int> ring(int v) const;
+  Fan<int> ring(int v) const;
 
   Verdict judge(int f) const;
   bool should_flip(int a, int b) const;
@@ -223,23 +243,24 @@ class Editor {
   long splits_ = 0, flips_ = 0, contractions_ = 0, thin_tried_ = 0;
 };
 
-std::vector<int> Editor::star(int v) const {
-  std::vector<int> out;
+Fan<int> Editor::star(int v) const {
+  Fan<int> out;
   const int start = corner_face_[static_cast<size_t>(v)];
   if (start < 0) return out;
   int f = start;
   do {
+    if (out.full()) return {};
     out.push_back(f);
     const Triangle& t = tri(f);
     const size_t k = static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin());
     f = face_of(v, t[(k + 2) % 3]);  // across the edge into v
-    if (f < 0 || out.size() > 64) return {};
+    if (f < 0) return {};
   } while (f != start);
   return out;
 }
 
-std::vector<int> Editor::ring(int v) const {
-  std::vector<int> out;
+Fan<int> Editor::ring(int v) const {
+  Fan<int> out;
   for (int f : star(v)) {
     const Triangle& t = tri(f);
     out.push_back(t[(static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin()) + 1) % 3]);
@@ -368,14 +389,14 @@ bool Editor::try_split(int f, std::vector<int>& touched) {
 bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
   const int f = face_of(gone, kept), g = face_of(kept, gone);
   if (f < 0 || g < 0) return false;
-  const std::vector<int> around_gone = ring(gone);
+  const Fan<int> around_gone = ring(gone);
   if (around_gone.size() < 3) return false;
-  std::vector<int> fan;  // triangles around `gone` that stay, with `kept` in its place
+  Fan<int> fan;  // triangles around `gone` that stay, with `kept` in its place
   for (int v : around_gone) {
     const int h = face_of(gone, v);
     if (h != f && h != g) fan.push_back(h);
   }
-  std::vector<Triangle> renamed;
+  Fan<Triangle> renamed;
   for (int h : fan) {
     Triangle t = tri(h);
     std::replace(t.begin(), t.end(), gone, kept);
@@ -386,13 +407,13 @@ bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
   // thinning contractions) before the link condition, whose rings cost more.
   for (const Triangle& t : renamed)
     if (!shape_passes({at(t[0]), at(t[1]), at(t[2])}, accept_.min_angle)) return false;
-  const std::vector<int> around_kept = ring(kept);
+  const Fan<int> around_kept = ring(kept);
   if (around_kept.size() < 3 || around_gone.size() + around_kept.size() < 8) return false;
   long common = 0;
   for (int v : around_gone) common += std::count(around_kept.begin(), around_kept.end(), v);
   if (common != 2) return false;
   // The corners opposite the edge lose a neighbour: each keeps three.
-  if (ring(third(f, gone, kept)).size() < 4 || ring(third(g, gone, kept)).size() < 4) return false;
+  if (star(third(f, gone, kept)).size() < 4 || star(third(g, gone, kept)).size() < 4) return false;
   // Then judged whole before the edit, on a copy of each triangle.
   for (size_t i = 0; i < fan.size(); ++i) {
     const Triangle saved = tri(fan[i]);
