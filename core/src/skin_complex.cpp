@@ -510,15 +510,33 @@ double SkinComplex::max_abs_curvature(const Eigen::Vector3d& x, int c) const {
   const MixedCell& cell = cells_[static_cast<size_t>(c)];
   const double s = shrink_;
   const Eigen::Vector3d y = x - cell.center;
-  const Eigen::Vector3d g = skin_gradient(s, y, cell.P * y);
+  const Eigen::Vector3d py = cell.P * y;
+  const Eigen::Vector3d g = skin_gradient(s, y, py);
   const double gn = g.norm();
   if (gn == 0.0) return 0.0;
-  // As curvature(): S = T^T H T / |g| with H = 2 (I - P) - 2s/(1-s) P, whose
-  // eigenvalues m +- r give max |k| = |m| + r.
+  // As curvature(): S = T^T H T / |g| with H = 2 I - (2 + h) P, T an
+  // orthonormal basis of the tangent plane. Its eigenvalues are
+  // (2 - (2 + h) mu) / |g|, mu those of T^T P T. Where P is the orthogonal
+  // projector of a simplex that is not flat, they follow from its rank and
+  // q = n^T P n alone (P g = -h P y, so q = h^2 |P y|^2 / |g|^2): mu is
+  // {0, 0} for a vertex, {0, 1 - q} for an edge, {1, 1 - q} for a
+  // triangle and {1, 1} for a tetrahedron.
+  const double h = 2.0 * s / (1 - s);
+  if (!cell.degenerate) {
+    const double bent = std::abs(2.0 - (2.0 + h) * (1.0 - h * h * py.squaredNorm() / (gn * gn)));
+    switch (cell.dim) {
+      case 0: return 2.0 / gn;
+      case 1: return std::max(2.0, bent) / gn;
+      case 2: return std::max(h, bent) / gn;
+      default: break;
+    }
+    if (cell.P == Eigen::Matrix3d::Identity()) return h / gn;
+  }
+  // A flat simplex's P (a pseudo-inverse's) has a rank below its
+  // dimension: the 2x2 shape operator in closed form, no directions.
   const Eigen::Vector3d n = g / gn;
   const Eigen::Vector3d t1 = n.unitOrthogonal();
   const Eigen::Vector3d t2 = n.cross(t1);
-  const double h = 2.0 * s / (1 - s);
   auto shape = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
     return (2.0 * u.dot(v) - (2.0 + h) * u.dot(cell.P * v)) / gn;
   };

@@ -77,6 +77,39 @@ TEST_CASE("a two-ball neck has the hyperboloid's principal curvatures", "[curvat
   }
 }
 
+TEST_CASE("a three-ball triangle cell has the two-sheet hyperboloid's principal curvatures", "[curvature]") {
+  // Three equal balls on a circle of radius d about the origin in the xy
+  // plane, overlapping in common (R2 = d^2 - w < 0). In the triangle cell
+  // the skin is (1-s) t^2 - s rho^2 + s(1-s) R2 = 0 (t: height over the
+  // plane, rho: distance from the axis through z_X = 0), i.e.
+  // G = t^2 - a rho^2 + s R2 = 0 with a = s/(1-s): a surface of revolution
+  // about the z axis. Its curvatures, from G's gradient and Hessian:
+  //   parallel:  a / sqrt(a^2 rho^2 + t^2),
+  //   meridian:  a s |R2| / (a^2 rho^2 + t^2)^(3/2).
+  const double d = 2.0, w = 5.0, R2 = d * d - w;
+  std::vector<Ball> balls;
+  for (int k = 0; k < 3; ++k)
+    balls.push_back({{d * std::cos(2 * M_PI * k / 3), d * std::sin(2 * M_PI * k / 3), 0}, w});
+  for (double s : {0.5, 0.3}) {
+    const SkinComplex sc = build_skin_complex(balls, {s});
+    const double a = s / (1 - s);
+    for (double rho : {0.0, 0.1, 0.25}) {
+      const double t = std::sqrt(a * rho * rho - s * R2);
+      const Eigen::Vector3d x(rho * std::cos(0.4), rho * std::sin(0.4), t);
+      const int cell = sc.locate(x);
+      INFO("s = " << s << ", rho = " << rho);
+      REQUIRE(sc.cell(cell).dim == 2);
+      CHECK(std::abs(sc.value(x)) < 1e-12);
+      const double q = a * a * rho * rho + t * t;
+      const double parallel = a / std::sqrt(q), meridian = a * s * std::abs(R2) / std::pow(q, 1.5);
+      const PrincipalCurvatures pc = sc.curvature(x, cell);
+      CHECK(std::max(std::abs(pc.k1), std::abs(pc.k2)) == Approx(std::max(parallel, meridian)).epsilon(1e-10));
+      CHECK(std::min(std::abs(pc.k1), std::abs(pc.k2)) == Approx(std::min(parallel, meridian)).epsilon(1e-10));
+      CHECK(sc.max_abs_curvature(x, cell) == Approx(std::max(parallel, meridian)).epsilon(1e-10));
+    }
+  }
+}
+
 TEST_CASE("target size follows curvature and respects its clamps", "[curvature][sizing]") {
   const SkinComplex sc = build_skin_complex({{{0, 0, 0}, 2.0}}, {0.5});
   const Eigen::Vector3d x(1.0, 0, 0);  // radius sqrt(0.5*2) = 1
