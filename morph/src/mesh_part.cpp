@@ -18,6 +18,14 @@ SurfaceMesh used_part(const SurfaceMesh& mesh, const std::vector<char>& keep_tri
       for (int v : mesh.triangles[f]) renumber[static_cast<size_t>(v)] = 0;
   SurfaceMesh part;
   kept_from.clear();
+  const size_t vertices = static_cast<size_t>(std::count(renumber.begin(), renumber.end(), 0));
+  part.vertices.reserve(vertices);
+  part.cells.reserve(vertices);
+  part.normals.reserve(vertices);
+  kept_from.reserve(vertices);
+  part.triangles.reserve(keep_triangle.empty() ? mesh.triangles.size()
+                                               : static_cast<size_t>(std::count_if(keep_triangle.begin(), keep_triangle.end(),
+                                                                               [](char k) { return k != 0; })));
   for (size_t v = 0; v < renumber.size(); ++v) {
     if (renumber[v] < 0) continue;
     renumber[v] = static_cast<int>(part.vertices.size());

@@ -337,6 +337,7 @@ std::vector<CellMap> cell_maps(const SkinComplex& from, const SkinComplex& to, c
       m.persisting = to.find_cell(c0.balls);
       if (m.persisting < 0) continue;
       m.quiet = cell_of_flagged_balls(c0, quiet);
+      if (m.quiet) continue;  // its vertices stay where they are (move_vertex)
       const MixedCell& c1 = to.cell(m.persisting);
       const double ratio = c1.R2 / c0.R2;
       m.mapped = !c0.degenerate && !c1.degenerate && c0.dim == c1.dim && c0.R2 != 0 && ratio > 0;

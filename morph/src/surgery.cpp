@@ -39,7 +39,12 @@ class EdgeIndex {
       start_[v + 1] = start_[v] + room_[v];
     }
     start_.pop_back();
-    slots_.resize(static_cast<size_t>(start_.empty() ? 0 : start_.back() + room_.back()));
+    // Room to grow without moving every slot: the first vertex an edit adds
+    // or the first block that fills would otherwise copy the whole index.
+    const size_t slots = static_cast<size_t>(start_.empty() ? 0 : start_.back() + room_.back());
+    slots_.reserve(slots + slots / 8 + 1024);
+    for (std::vector<int>* per_vertex : {&start_, &count_, &room_}) per_vertex->reserve(vertices + vertices / 16 + 64);
+    slots_.resize(slots);
     // Each directed edge of a closed oriented manifold once: no lookup.
     for (size_t f = 0; f < triangles.size(); ++f) {
       const auto& t = triangles[f];
