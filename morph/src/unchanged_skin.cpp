@@ -138,9 +138,14 @@ std::vector<char> skin_unchanged_near(const SkinComplex& from, const std::vector
       const double lost = std::max(e.value, 0.0) + grad * rho + rho * rho;
       const double reach = inactive_beyond(s, rho, 0.5 * grad, heaviest, e.value, kOffSkin);
       if (!std::isfinite(reach)) continue;  // unproven
+      const double reach2 = reach * reach;
       unchanged[v] = !grid.any_near(x0, reach, [&](int k, const Eigen::Vector3d&) {
         const Place& p = places[static_cast<size_t>(k)];
-        const double d = (p.center - x0).norm();
+        // The grid's cells cover a cube: past `reach` the bound above proves
+        // a place inactive already, whatever its distance from y.
+        const double d2 = (p.center - x0).squaredNorm();
+        if (d2 >= reach2) return false;
+        const double d = std::sqrt(d2);
         if (!(d > rho)) return true;
         const double spread = (p.center - y).norm() + rho / (1 - s);
         return !((d - rho) * (d - rho) - (1 - s) * spread * spread - s * p.weight - lost > kOffSkin);
