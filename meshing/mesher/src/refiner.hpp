@@ -249,6 +249,26 @@ class Refiner {
            roles_[static_cast<size_t>(id)] != PatchRole::context;
   }
   bool active(const FacetKey& ids) const { return active(ids[0]) && active(ids[1]) && active(ids[2]); }
+  // Patch mode, a triangulation of dimension 3: calls visit(facet) for
+  // each finite facet whose corners are all active, from the cell the
+  // triangulation's facet iterator reports it from (the one of lower
+  // address; the finite one on the hull). Most of a patch's cells hold
+  // context vertices: a cell with fewer than three active corners is
+  // passed over without reading its facets.
+  template <class Visit>
+  void active_facets(Visit visit) const {
+    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
+      int inactive = -1, count = 0;
+      for (int k = 0; k < 4; ++k)
+        if (!active(c->vertex(k)->info().id)) inactive = k, ++count;
+      if (count > 1) continue;
+      for (int i = 0; i < 4; ++i) {
+        if (count == 1 && i != inactive) continue;  // the facet holds the inactive corner
+        const Cell_handle n = c->neighbor(i);
+        if (dt_.is_infinite(n) || Cell_handle(c) < n) visit(Facet(c, i));
+      }
+    }
+  }
   bool star_checked(int id) const {
     return roles_.empty() || id >= static_cast<int>(roles_.size()) ||
            roles_[static_cast<size_t>(id)] == PatchRole::interior;

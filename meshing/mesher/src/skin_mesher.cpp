@@ -671,10 +671,14 @@ bool Refiner::global_pass() {
     }
     scanned.clear();
   };
-  for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) {
-    scanned.push_back(*f);
+  const auto scan = [&](const Facet& f) {
+    scanned.push_back(f);
     if (scanned.size() == 4 * kChunk) take_scanned();
-  }
+  };
+  if (!roles_.empty() && dt_.dimension() == 3)
+    active_facets(scan);
+  else
+    for (auto f = dt_.finite_facets_begin(); f != dt_.finite_facets_end(); ++f) scan(*f);
   take_scanned();
   for (; !batch_found_.empty(); batch_found_.pop_front()) {
     const BatchFound& f = batch_found_.front();
