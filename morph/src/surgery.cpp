@@ -4,6 +4,7 @@
 #include "mesh_part.hpp"
 
 #include <Eigen/Geometry>
+#include <boost/container/static_vector.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -108,25 +109,14 @@ class EdgeIndex {
   std::vector<std::pair<int, int>> slots_;  // (to, triangle)
 };
 
-// The triangles or vertices around one vertex, kept on the stack: the
-// thinning asks for four such lists for each edge it tries, hundreds of
-// edges a frame, and heap lists cost about a tenth of a small molecule's
-// frame. A vertex with more triangles than this is left alone by the edits.
+// The triangles or vertices around one vertex, kept on the stack (Boost's
+// fixed-capacity vector): the thinning asks for four such lists for each
+// edge it tries, hundreds of edges a frame, and heap lists cost about a
+// tenth of a small molecule's frame. A vertex with more triangles than
+// this is left alone by the edits.
 constexpr size_t kMostFan = 64;
 template <class T>
-class Fan {
- public:
-  bool full() const { return size_ == kMostFan; }
-  void push_back(const T& x) { items_[size_++] = x; }
-  size_t size() const { return size_; }
-  const T* begin() const { return items_.data(); }
-  const T* end() const { return items_.data() + size_; }
-  const T& operator[](size_t k) const { return items_[k]; }
-
- private:
-  std::array<T, kMostFan> items_;
-  size_t size_ = 0;
-};
+using Fan = boost::container::static_vector<T, kMostFan>;
 
 double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d u = (a - apex).normalized(), w = (b - apex).normalized();
@@ -254,7 +244,7 @@ Fan<int> Editor::star(int v) const {
   if (start < 0) return out;
   int f = start;
   do {
-    if (out.full()) return {};
+    if (out.size() == kMostFan) return {};
     out.push_back(f);
     const Triangle& t = tri(f);
     const size_t k = static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin());
