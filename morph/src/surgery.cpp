@@ -118,6 +118,14 @@ constexpr size_t kMostFan = 64;
 template <class T>
 using Fan = boost::container::static_vector<T, kMostFan>;
 
+// Of the triangle a b c; infinite when its corners are collinear.
+double circumradius_squared(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d u = b - a, w = c - a, uxw = u.cross(w);
+  const double cross2 = uxw.squaredNorm();
+  if (!(cross2 > 0)) return INFINITY;
+  return (u.squaredNorm() * w.cross(uxw) + w.squaredNorm() * uxw.cross(u)).squaredNorm() / (4.0 * cross2 * cross2);
+}
+
 double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d u = (a - apex).normalized(), w = (b - apex).normalized();
   return std::acos(std::clamp(u.dot(w), -1.0, 1.0));
@@ -409,8 +417,17 @@ bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
   if (common != 2) return false;
   // The corners opposite the edge lose a neighbour: each keeps three.
   if (star(third(f, gone, kept)).size() < 4 || star(third(g, gone, kept)).size() < 4) return false;
-  // Then judged whole before the edit, on a copy of each triangle.
+  // Then judged whole before the edit, on a copy of each triangle, the
+  // widest first: most refusals are for size or distance, which the widest
+  // triangle fails first, and the first failure ends the judging.
+  Fan<std::pair<double, size_t>> widest_first;
   for (size_t i = 0; i < fan.size(); ++i) {
+    const Triangle& t = renamed[i];
+    widest_first.emplace_back(-circumradius_squared(at(t[0]), at(t[1]), at(t[2])), i);
+  }
+  std::sort(widest_first.begin(), widest_first.end());
+  for (const auto& entry : widest_first) {
+    const size_t i = entry.second;
     const Triangle saved = tri(fan[i]);
     mesh_.triangles[static_cast<size_t>(fan[i])] = renamed[i];
     const bool passes = judge(fan[i]) == Verdict::pass;
