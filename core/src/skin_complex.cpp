@@ -149,9 +149,20 @@ std::array<int, 3> SkinComplex::grid_cell_of(const Eigen::Vector3d& x) const {
 // its rounding, ~1e-16 of |v|^2 (1e-13 A^2 at 30 A), over twice the gap can
 // move the bisector by 1e-4 A. Here z_0 - z_k and w_0 - w_k are exact when
 // the balls are close (Sterbenz), and the product keeps its relative accuracy.
-static double power_gain(const Ball& bk, const Ball& b0, const Eigen::Vector3d& v) {
-  return (b0.center - bk.center).dot(2.0 * v - b0.center - bk.center) + (b0.weight - bk.weight);
-}
+// The loops over a cell's cofaces (a vertex cell has one per neighbouring
+// ball) call it tens of millions of times a morph: 2v - z_0 is worked out
+// once per cell, and the call is inlined.
+class PowerGain {
+ public:
+  PowerGain(const Ball& b0, const Eigen::Vector3d& v) : b0_(b0), two_v_less_z0_(2.0 * v - b0.center) {}
+  double operator()(const Ball& bk) const {
+    return (b0_.center - bk.center).dot(two_v_less_z0_ - bk.center) + (b0_.weight - bk.weight);
+  }
+
+ private:
+  const Ball& b0_;
+  const Eigen::Vector3d two_v_less_z0_;
+};
 
 // x = (1-s) d + s v with d = z + P(x-z)/(1-s) in aff(delta_X) and v = z + (I-P)(x-z)/s
 // in aff(nu_X); x is in mu_X iff d is in delta_X (barycentric coordinates >= 0)
@@ -179,13 +190,13 @@ static Violation worst_violation(const SkinComplex& sc, int c, const Eigen::Vect
     }
     if (worst.target >= 0) return worst;
   }
-  const Eigen::Vector3d v = cell.center + (y - py) / s;
+  const PowerGain power_gain(b0, cell.center + (y - py) / s);  // at v
   for (auto it = sc.cofaces_begin(c); it != sc.cofaces_end(c); ++it) {
     // A flat coface's ball is co-orthogonal with X's along aff(nu_X): its
     // bound is void (rounding noise); the cells beyond it bound nu_X instead.
     if (it->flat) continue;
     const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
-    const double gain = power_gain(bk, b0, v);
+    const double gain = power_gain(bk);
     if (!(gain < 0)) continue;  // v on X's side: no violation, and no square root to take (most cofaces)
     const double gap = (bk.center - b0.center).norm();
     const double slack = gain / (2 * std::max(gap, 1e-300));  // signed distance to the bisector
@@ -428,13 +439,14 @@ static CellExit segment_exit(const SkinComplex& sc, int c, const Eigen::Vector3d
   }
   const Eigen::Vector3d v0 = cell.center + (y0 - cell.P * y0) / s;
   const Eigen::Vector3d v1 = (dir - cell.P * dir) / s;
+  const PowerGain power_gain(b0, v0);
   for (auto it = sc.cofaces_begin(c); it != sc.cofaces_end(c); ++it) {
     if (it->flat) continue;  // void bound (see worst_violation)
     const Ball& bk = sc.balls()[static_cast<size_t>(it->ball)];
     // pi_k(v) - pi_0(v) = -2 <v, z_k - z_0> + |z_k|^2 - w_k - |z_0|^2 + w_0
     const double slope = -2.0 * v1.dot(bk.center - b0.center);
     if (slope >= 0) continue;  // the segment does not approach this bisector (consider's own first test)
-    consider(power_gain(bk, b0, v0), slope, it->cell, it->beyond);
+    consider(power_gain(bk), slope, it->cell, it->beyond);
   }
   return exit;
 }
