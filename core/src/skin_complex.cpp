@@ -80,6 +80,12 @@ double SkinComplex::quadric(int c, const Eigen::Vector3d& x) const {
   return quadric_at(cell, shrink_, y, cell.P * y);
 }
 
+Eigen::Vector3d SkinComplex::gradient(int c, const Eigen::Vector3d& x) const {
+  const MixedCell& cell = cells_[static_cast<size_t>(c)];
+  const Eigen::Vector3d y = x - cell.center;
+  return skin_gradient(shrink_, y, cell.P * y);
+}
+
 int SkinComplex::owning_ball(const Eigen::Vector3d& x, int cell) const {
   const MixedCell& c = cells_[static_cast<size_t>(cell)];
   int best = c.balls[0];

@@ -90,7 +90,9 @@ bool shape_passes(const std::array<Eigen::Vector3d, 3>& corners, double min_angl
 
 bool faces_outward(const SkinComplex& complex, const RestrictedTriangle& triangle) {
   const auto& c = triangle.corners;
-  const Eigen::Vector3d outward = complex.evaluate(triangle.ball_center, triangle.ball_cell).gradient;
+  // The ball centre is a crossing found in ball_cell: no walk to locate it,
+  // which cost about a sixth of judging a triangle.
+  const Eigen::Vector3d outward = complex.gradient(triangle.ball_cell, triangle.ball_center);
   return (c[1] - c[0]).cross(c[2] - c[0]).dot(outward) > 0;
 }
 

@@ -141,6 +141,9 @@ class SkinComplex {
 
   // Q_X(x) = (1-s)|(I-P)(x-z)|^2 - s|P(x-z)|^2 + s(1-s)R2, equal to (1-s) F(x) on mu_X.
   double quadric(int cell, const Eigen::Vector3d& x) const;
+  // The gradient of F by the cell's quadric, for x known to lie in mu_X (a
+  // crossing intersect_segment found there): evaluate without locating x.
+  Eigen::Vector3d gradient(int cell, const Eigen::Vector3d& x) const;
   // Largest violation of x in mu_X (Angstrom-scaled): <= 0 means inside.
   double membership_violation(int cell, const Eigen::Vector3d& x) const;
 
