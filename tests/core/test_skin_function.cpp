@@ -221,6 +221,29 @@ TEST_CASE("the oracle started from given balls gives the answer it gives from th
   CHECK_THROWS_AS(oracle.evaluate(near[0], {static_cast<int>(balls.size()), -1, -1, -1}), ContractError);
 }
 
+TEST_CASE("the gradient read in a crossing's own cell is the oracle's", "[skin][oracle][segment]") {
+  // faces_outward reads the gradient at a triangle's surface ball centre,
+  // a crossing of its normal line, in the cell the walk found it in,
+  // without locating the point again: on the cell's boundary too (the skin
+  // is C1), it must be the skin's gradient there.
+  const double s = 0.5;
+  const auto balls = balls_from_molecule(read_molecule(test::data_file("1ubi.pdb")), s);
+  const SkinComplex sc = build_skin_complex(balls, {s});
+  const SkinOracle oracle(balls, s);
+  const auto near = test::sample_near_balls(balls, s, 400, 1.0, 11);
+  long crossings = 0;
+  for (size_t i = 0; i + 1 < near.size(); i += 2)
+    for (const SegmentCrossing& c : sc.intersect_segment(near[i], near[i + 1])) {
+      const OracleResult o = oracle.evaluate(c.point);
+      REQUIRE(o.certified);
+      const Eigen::Vector3d g = sc.gradient(c.cell, c.point);
+      CHECK((g - o.gradient).norm() <= 1e-9 * (1 + o.gradient.norm()));
+      CHECK((g.dot(near[i + 1] - near[i]) < 0) == c.entering);
+      ++crossings;
+    }
+  CHECK(crossings >= 200);
+}
+
 TEST_CASE("cospherical and interpolated ball sets: skin function and crossings equal the oracle",
           "[skin][oracle][degenerate][segment]") {
   const double s = 0.5;
