@@ -14,11 +14,11 @@
 // turned by 20 degrees, and 1ubi's atoms in MD-like thermal motion (each
 // atom fluctuating about its place, below), each over N frames (default 101).
 // (b) costs about the same at every frame and averages a sample spread over
-// the run, after one untimed rebuild of the first frame. Quality is measured with the clock stopped, by the commands' own
-// check (check_guarantees): every frame graded (closed, manifold, oriented,
-// self-intersections, angles, components, voids and Euler characteristic
-// against the skin's) and every vertex measured by the static oracle of the
-// frame's balls.
+// the run, after one untimed rebuild of the first frame. Quality is measured
+// with the clock stopped, by the commands' own check (check_guarantees):
+// every frame graded (closed, manifold, oriented, self-intersections,
+// angles, components, voids and Euler characteristic against the skin's)
+// and every vertex measured by the static oracle of the frame's balls.
 //
 //   bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command]
 //                [--first-size-margin X]   (c only: MovingOptions::first_size_margin, default the engine's)
