@@ -59,7 +59,7 @@ struct MorphCommandOptions {
   double max_step = MovingOptions{}.max_step;  // Angstrom, --pairs matched
   FrameFileOptions files;
   MorphOptions morph;
-  bool no_self_intersections = false;
+  FrameCrossingOptions crossings;
 };
 
 void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
@@ -102,7 +102,7 @@ void add_morph_options(CLI::App& cmd, MorphCommandOptions& o) {
   cmd.add_option("--threads", o.morph.first.threads, "threads (0: all)")
       ->check(finite_number())->check(non_negative_number());
   add_frame_file_options(cmd, o.files);
-  cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
+  add_frame_crossing_options(cmd, o.crossings);
   add_molecule_settings(cmd, o.molecule, ModelChoice::none);
 }
 
@@ -208,7 +208,8 @@ struct FrameReference {
 // from the live pairs of the vertex's overlay cell (`starts`, indices into
 // reference.pairs; empty: its own start). The topology from B(t)'s balls.
 FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleStart>& starts,
-                             const FrameReference& reference, double t, double min_angle, bool self_intersections) {
+                             const std::vector<long>& ids, const FrameReference& reference, double t,
+                             double min_angle, FrameCrossings& crossings) {
   SkinReference skin;
   skin.balls = reference.balls_at(t);
   skin.shrink = reference.shrink;
@@ -220,7 +221,7 @@ FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleSt
     const MorphOracleResult e = reference.oracle.evaluate(x, t, pairs);
     return SkinDistance{e.distance(), e.certified};
   };
-  return check_frame(mesh, skin, min_angle, self_intersections);
+  return check_frame(mesh, ids, skin, min_angle, crossings);
 }
 
 // The m x n morph's frames.jsonl line: the common fields and its events.
@@ -387,7 +388,7 @@ ExitCode run_matched_morph(const MorphCommandOptions& o, const GlobalOptions& gl
   run.options = moving_options(options);
   run.options.max_step = o.max_step;
   FrameFiles files(o.files, sides.source, sides.target);
-  run.self_intersections = !o.no_self_intersections;
+  run.crossings = o.crossings;
   if (progress) run.progress = std::make_shared<ProgressLine>(true);
   OutputDirectory dir(o.directory);
   OutputSet outputs;
@@ -484,10 +485,11 @@ struct BlendOutputs {
 // staged while frame k+1 is made (the morph's repairs are mostly serial).
 // False, with the failing frame reported, when a frame fails a guarantee.
 bool make_blend_frames(Morph& morph, const std::vector<double>& times, const FrameReference& reference,
-                       double min_angle, bool self_intersections, const BlendOutputs& out) {
+                       double min_angle, const FrameCrossingOptions& crossing_options, const BlendOutputs& out) {
   PaceEstimate pace(times.size());
   BlendFrame pending;
   FrameCheck check;
+  FrameCrossings crossings(crossing_options);
   tbb::task_group checking;  // after what its task reads: if advance_to throws, it waits before they go
   const auto finish = [&]() {
     checking.wait();
@@ -511,7 +513,8 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
     if (k > 0 && !finish()) return false;
     pending = std::move(made);
     checking.run([&] {  // the check, then the frame's files, beside the next frame
-      check = check_blend_frame(pending.frame.mesh, pending.starts, reference, pending.t, min_angle, self_intersections);
+      check = check_blend_frame(pending.frame.mesh, pending.starts, pending.frame.ids, reference, pending.t, min_angle,
+                                crossings);
       if (check.holds()) stage_frame(out.outputs, out.dir, pending, out.files);
     });
   }
@@ -560,7 +563,7 @@ ExitCode run_morph_frames(const MorphCommandOptions& o, const GlobalOptions& glo
   std::ostringstream lines;
   FrameCounts counts;
   const BlendOutputs out{files, outputs, dir, *shown, lines, counts};
-  if (!make_blend_frames(morph, times, reference, options.frames.min_angle, !o.no_self_intersections, out))
+  if (!make_blend_frames(morph, times, reference, options.frames.min_angle, o.crossings, out))
     return ExitCode::not_met;
   shown->finish();
   json report = morph_json(o, sides, morph, times, options);

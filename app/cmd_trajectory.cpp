@@ -39,7 +39,7 @@ struct TrajectoryOptions {
   std::string align = "kabsch";
   MovingOptions moving;
   FrameFileOptions files;
-  bool no_self_intersections = false;
+  FrameCrossingOptions crossings;
 };
 
 void add_trajectory_options(CLI::App& cmd, TrajectoryOptions& o) {
@@ -65,7 +65,7 @@ void add_trajectory_options(CLI::App& cmd, TrajectoryOptions& o) {
   cmd.add_option("--max-triangles", o.moving.first.max_triangles, "stop with an error past this many triangles")
       ->check(finite_number())->check(positive_number())->capture_default_str();
   add_frame_file_options(cmd, o.files);
-  cmd.add_flag("--no-self-intersections", o.no_self_intersections, "skip the exact self-intersection check");
+  add_frame_crossing_options(cmd, o.crossings);
   add_molecule_settings(cmd, o.molecule, ModelChoice::none);
 }
 
@@ -157,7 +157,7 @@ ExitCode run_trajectory_frames(const TrajectoryOptions& o, const GlobalOptions& 
   // order: both sides' atoms are the first model's (one table, twice).
   const Molecule& first = all[static_cast<size_t>(models.front() - 1)];
   FrameFiles files(o.files, first, first);
-  run.self_intersections = !o.no_self_intersections;
+  run.crossings = o.crossings;
   if (progress) run.progress = std::make_shared<ProgressLine>(true);
   if (progress)
     std::cerr << "skinmesh: " << models.size() << " models of " << all.size() << ", " << keys.front().size()

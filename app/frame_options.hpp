@@ -20,4 +20,14 @@ inline void add_frame_file_options(CLI::App& cmd, FrameFileOptions& o) {
       ->check(CLI::IsMember(colouring_names()))->capture_default_str();
 }
 
+// --no-self-intersections, and --self-intersections: which pairs of a
+// frame's triangles the exact test looks at.
+inline void add_frame_crossing_options(CLI::App& cmd, FrameCrossingOptions& o) {
+  CLI::Option* skip = cmd.add_flag("--no-self-intersections", o.skip, "skip the exact self-intersection check");
+  cmd.add_option("--self-intersections", o.pairs,
+                 "pairs of triangles the exact self-intersection check tests: changed (the first frame's all, then "
+                 "those with a triangle that changed since the frame before) or all (every pair of every frame)")
+      ->check(CLI::IsMember({"changed", "all"}))->capture_default_str()->excludes(skip);
+}
+
 }  // namespace skinmesh::app

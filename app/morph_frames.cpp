@@ -189,14 +189,28 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees) {
   return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
 }
 
-FrameCheck check_frame(const SurfaceMesh& mesh, const SkinReference& skin, double min_angle, bool self_intersections) {
+const std::vector<char>* FrameCrossings::changed(const SurfaceMesh& mesh, const std::vector<long>& ids) {
+  if (options_.skip || options_.pairs != "changed" || certified_.empty()) return nullptr;
+  changed_ = certified_.changed(mesh, ids);
+  return &changed_;
+}
+
+void FrameCrossings::checked(const SurfaceMesh& mesh, const std::vector<long>& ids, bool held) {
+  if (options_.skip || options_.pairs != "changed") return;
+  certified_ = held ? CertifiedTriangles(mesh, ids) : CertifiedTriangles();
+}
+
+FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, const SkinReference& skin,
+                       double min_angle, FrameCrossings& crossings) {
   GuaranteeOptions o;
   o.min_angle = min_angle;
   o.on_skin_tolerance = kFrameOnSkinTolerance;
-  o.self_intersections = self_intersections ? SelfIntersectionCheck::exact : SelfIntersectionCheck::skip;
+  o.self_intersections = crossings.skipped() ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
+  o.changed_triangles = crossings.changed(mesh, ids);
   FrameCheck c;
   c.guarantees = check_guarantees(mesh, skin, o);
   c.share_below_bound = share_below(mesh, min_angle);
+  crossings.checked(mesh, ids, c.holds());
   return c;
 }
 
@@ -229,6 +243,8 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"euler", q.euler},
           {"skin_topology", {{"components", skin.components}, {"voids", skin.voids}, {"euler", skin.euler}}},
           {"self_intersecting_pairs", q.self_intersections_checked ? json(q.self_intersecting_pairs) : json(nullptr)},
+          {"self_intersection_triangles_tested",
+           q.self_intersections_checked ? json(q.self_intersection_triangles_tested) : json(nullptr)},
           {"seconds", s.seconds},
           {"seconds_complex", s.seconds_complex},
           {"seconds_transport", s.seconds_transport},
@@ -274,9 +290,9 @@ MadeFrame snapshot(const MovingBalls& moving, size_t k) {
   return m;
 }
 
-FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, bool self_intersections) {
-  return check_frame(made.frame.mesh, SkinReference{made.balls, made.shrink, {}, made.starts, made.topology},
-                     min_angle, self_intersections);
+FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, FrameCrossings& crossings) {
+  return check_frame(made.frame.mesh, made.frame.ids,
+                     SkinReference{made.balls, made.shrink, {}, made.starts, made.topology}, min_angle, crossings);
 }
 
 json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
@@ -325,6 +341,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
   MovingBalls moving(run.balls_of(0), options, run.times.front());
   MadeFrame pending;
   FrameCheck check;
+  FrameCrossings crossings(run.crossings);
   tbb::task_group checking;
   // Waits for the pending frame's check and files, then records its line; false when it failed.
   const auto finish = [&]() {
@@ -353,7 +370,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
     if (k > 0 && !finish()) return result;
     pending = std::move(made);
     checking.run([&] {
-      check = check_moving_frame(pending, run.options.frames.min_angle, run.self_intersections);
+      check = check_moving_frame(pending, run.options.frames.min_angle, crossings);
       if (check.holds()) stage_moving_frame(outputs, dir, pending, run, files);
     });
   }

@@ -15,6 +15,7 @@
 #include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/quality/certified_triangles.hpp"
 #include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
@@ -105,8 +106,36 @@ struct FrameCheck {
 };
 // Every vertex of a frame within this of the frame's skin (Angstrom).
 constexpr double kFrameOnSkinTolerance = 1e-8;
-// The frame checked against `skin`: every guarantee, the topology included.
-FrameCheck check_frame(const SurfaceMesh& mesh, const SkinReference& skin, double min_angle, bool self_intersections);
+
+// Which pairs of a frame's triangles the exact self-intersection test
+// looks at: none (skip), every pair ("all"), or ("changed") every pair of
+// the first frame and then the pairs with a triangle that changed since
+// the frame before (CertifiedTriangles: the others are where they were, by
+// vertex id, and met only at shared corners then).
+struct FrameCrossingOptions {
+  bool skip = false;
+  std::string pairs = "changed";
+};
+// The test's state through a run of frames, checked one after the other.
+class FrameCrossings {
+ public:
+  explicit FrameCrossings(FrameCrossingOptions o = {}) : options_(std::move(o)) {}
+  bool skipped() const { return options_.skip; }
+  // Per triangle of `mesh` (ids per vertex), the triangles to test: null for all.
+  const std::vector<char>* changed(const SurfaceMesh& mesh, const std::vector<long>& ids);
+  // After the frame's check: its triangles certified when every guarantee held.
+  void checked(const SurfaceMesh& mesh, const std::vector<long>& ids, bool held);
+
+ private:
+  FrameCrossingOptions options_;
+  CertifiedTriangles certified_;
+  std::vector<char> changed_;
+};
+
+// The frame (ids per vertex) checked against `skin`: every guarantee, the
+// topology included; `crossings` then holds this frame as the one before.
+FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, const SkinReference& skin,
+                       double min_angle, FrameCrossings& crossings);
 // The frames.jsonl fields both kinds of morph write.
 nlohmann::json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file);
 
@@ -118,7 +147,7 @@ struct MovingFrames {
   // that side lacks it), written per vertex as frame_attributes says.
   std::vector<std::array<int, 2>> ball_atoms;
   MovingOptions options;
-  bool self_intersections = true;    // the exact check on every frame
+  FrameCrossingOptions crossings;    // the exact self-intersection check of every frame
   std::shared_ptr<ProgressLine> progress;  // null: none
 };
 

@@ -15,9 +15,11 @@
 
 #include <algorithm>
 #include <array>
+#include <map>
 #include <numeric>
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <csignal>
 #include <fcntl.h>
@@ -732,6 +734,112 @@ TEST_CASE("skinmesh trajectory: one morph through every model, each keyframe the
   CHECK(one.code == 2);
   CHECK(one.output.find("at least two models") != std::string::npos);
   std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
+namespace {
+
+std::string bytes_of(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Ubiquitin as two models, the second with the atoms of residues 1-8 moved
+// 0.4 A along x: the rest of the surface stays where it was.
+void write_two_ubiquitin_models(const std::string& path) {
+  std::ifstream in(skinmesh::test::data_file("1ubi.pdb"));
+  std::vector<std::string> atoms;
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("ATOM", 0) == 0) atoms.push_back(line);
+  std::ofstream out(path);
+  for (int model = 1; model <= 2; ++model) {
+    out << "MODEL     " << model << "\n";
+    for (std::string line : atoms) {
+      if (model == 2 && std::stoi(line.substr(22, 4)) <= 8) {
+        char x[9];
+        std::snprintf(x, sizeof x, "%8.3f", std::stod(line.substr(30, 8)) + 0.4);
+        line.replace(30, 8, x);
+      }
+      out << line << "\n";
+    }
+    out << "ENDMDL\n";
+  }
+  out << "END\n";
+}
+
+// The triangles of frame k of `dir` (PLY, with ids) that frame k - 1 does
+// not have: by their corners' ids, each corner where it was.
+long changed_triangles(const std::string& dir, size_t k) {
+  const auto read = [&](size_t frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%04zu.ply", frame);
+    return skinmesh::read_ply_with_properties(dir + name);
+  };
+  const skinmesh::PlyMesh before = read(k - 1), now = read(k);
+  const std::vector<double>& ids_before = before.vertex_properties.at("id");
+  const std::vector<double>& ids_now = now.vertex_properties.at("id");
+  std::map<long, Eigen::Vector3d> place;
+  for (size_t v = 0; v < ids_before.size(); ++v) place[static_cast<long>(ids_before[v])] = before.mesh.vertices[v];
+  const auto key = [](const std::array<int, 3>& t, const std::vector<double>& ids) {
+    std::array<long, 3> k3{static_cast<long>(ids[static_cast<size_t>(t[0])]), static_cast<long>(ids[static_cast<size_t>(t[1])]),
+                           static_cast<long>(ids[static_cast<size_t>(t[2])])};
+    std::sort(k3.begin(), k3.end());
+    return k3;
+  };
+  std::set<std::array<long, 3>> had;
+  for (const auto& t : before.mesh.triangles) had.insert(key(t, ids_before));
+  long changed = 0;
+  for (const auto& t : now.mesh.triangles) {
+    bool same = had.count(key(t, ids_now)) > 0;
+    for (int v : t) {
+      const auto it = place.find(static_cast<long>(ids_now[static_cast<size_t>(v)]));
+      same = same && it != place.end() && it->second == now.mesh.vertices[static_cast<size_t>(v)];
+    }
+    changed += !same;
+  }
+  return changed;
+}
+
+}  // namespace
+
+TEST_CASE("skinmesh trajectory: a later frame's self-intersection test takes the pairs with a changed triangle",
+          "[cli][morph][moving]") {
+  // The frames are the same with every pair tested; the first frame tests
+  // every triangle, each later one those it does not share with the frame
+  // before (by the ids and places its PLY file gives), at least one of them
+  // fewer than all, and no frame has a crossing pair. Asking to skip the test and to
+  // test every pair at once is refused.
+  char pattern[] = "/tmp/skinmesh-crossings-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string base = pattern, models = base + "/two.pdb";
+  write_two_ubiquitin_models(models);
+  const std::string common = "--quiet trajectory " + models + " --align none --frames-per-step 3 --format ply -o ";
+  const Run changed = run(common + base + "/changed");
+  INFO(changed.output);
+  REQUIRE(changed.code == 0);
+  const Run all = run(common + base + "/all --self-intersections all");
+  INFO(all.output);
+  REQUIRE(all.code == 0);
+  const std::vector<nlohmann::json> some = skinmesh::test::frame_lines(base + "/changed");
+  const std::vector<nlohmann::json> every = skinmesh::test::frame_lines(base + "/all");
+  REQUIRE(some.size() == 4);
+  REQUIRE(every.size() == some.size());
+  int fewer = 0;  // later frames that tested fewer triangles than they have
+  for (size_t k = 0; k < some.size(); ++k) {
+    INFO("frame " << k);
+    const std::string name = some[k]["file"].get<std::string>();
+    CHECK(bytes_of(base + "/changed/" + name) == bytes_of(base + "/all/" + name));
+    CHECK(some[k]["self_intersecting_pairs"] == 0);
+    CHECK(every[k]["self_intersecting_pairs"] == 0);
+    CHECK(every[k]["self_intersection_triangles_tested"] == every[k]["triangles"]);
+    const long tested = some[k]["self_intersection_triangles_tested"].get<long>();
+    CHECK(tested == (k == 0 ? some[k]["triangles"].get<long>() : changed_triangles(base + "/changed", k)));
+    fewer += k > 0 && tested < some[k]["triangles"].get<long>();
+  }
+  CHECK(fewer > 0);
+  const Run both = run(common + base + "/both --self-intersections all --no-self-intersections");
+  CHECK(both.code == 2);
+  CHECK_FALSE(std::filesystem::exists(base + "/both"));
+  std::system(("rm -rf " + base).c_str());
 }
 
 // At t = 0.9999 on 2k39 model 1 -> 3 (centroid, no Kabsch fit) the morph

@@ -6,6 +6,7 @@
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/molecule.hpp"
 #include "skinmesh/mesh_io/mesh_read.hpp"
+#include "skinmesh/quality/certified_triangles.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -224,6 +225,78 @@ TEST_CASE("self-intersections: a pile of bodies is counted as CGAL counts it, or
   const MeshQuality ring = grade_mesh(torus(400, 60, 3.0, 1.0));
   CHECK(ring.self_intersections_checked);
   CHECK(ring.self_intersection_box_pairs < 20 * ring.triangles);
+}
+
+TEST_CASE("self-intersections of changed triangles: with the rest certified, CGAL's count over every pair",
+          "[quality]") {
+  // A torus certified as a frame with ids that are not its indices, then
+  // changed as frames change: vertices moved (a band shaken by about an
+  // edge, folding among itself and against the triangles around it; one
+  // pushed across the hole through the far side), the vertices renumbered
+  // (nothing changed), an edge flipped (two new triangles on old places),
+  // and ids repeated (nothing certified). Each count is CGAL's over the
+  // whole mesh.
+  const SurfaceMesh ring = torus(40, 24, 3.0, 1.0);
+  std::vector<long> ids(ring.vertices.size());
+  for (size_t v = 0; v < ids.size(); ++v) ids[v] = 7 * static_cast<long>(v) + 1000;
+  const CertifiedTriangles certified(ring, ids);
+  REQUIRE_FALSE(certified.empty());
+  const auto changed_count = [](const std::vector<char>& c) { return std::count(c.begin(), c.end(), 1); };
+  CHECK(changed_count(certified.changed(ring, ids)) == 0);
+  CHECK(check_changed_self_intersections(ring, certified.changed(ring, ids), 1'000'000).box_pairs == 0);
+
+  SurfaceMesh shaken = ring;
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> shake(-0.3, 0.3);
+  for (size_t v = 10 * 24; v < 14 * 24; ++v) shaken.vertices[v] += Eigen::Vector3d(shake(random), shake(random), shake(random));
+  shaken.vertices[30 * 24] = Eigen::Vector3d(0.5, 0.2, 0.1) - shaken.vertices[30 * 24];  // through the far side
+  const std::vector<char> moved = certified.changed(shaken, ids);
+  for (size_t f = 0; f < shaken.triangles.size(); ++f) {
+    const auto& t = shaken.triangles[f];
+    const bool corner_moved = std::any_of(t.begin(), t.end(), [&](int v) { return shaken.vertices[static_cast<size_t>(v)] != ring.vertices[static_cast<size_t>(v)]; });
+    REQUIRE(moved[f] == corner_moved);
+  }
+  const long expected = test::cgal_self_intersecting_pairs(shaken);
+  REQUIRE(expected > 0);
+  const SelfIntersectionCount some = check_changed_self_intersections(shaken, moved, 1'000'000);
+  CHECK_FALSE(some.degenerate);
+  CHECK_FALSE(some.over_bound);
+  CHECK(some.pairs == expected);
+  CHECK(some.box_pairs < check_self_intersections(shaken, 1'000'000).box_pairs);
+  GradeOptions graded;
+  graded.changed = &moved;
+  const MeshQuality q = grade_mesh(shaken, graded);
+  CHECK(q.self_intersecting_pairs == expected);
+  CHECK(q.self_intersection_triangles_tested == changed_count(moved));
+
+  // The same triangles under other vertex numbers: nothing changed.
+  SurfaceMesh renumbered;
+  std::vector<long> renumbered_ids;
+  const int n = static_cast<int>(ring.vertices.size());
+  for (int v = n - 1; v >= 0; --v) {
+    renumbered.vertices.push_back(ring.vertices[static_cast<size_t>(v)]);
+    renumbered_ids.push_back(ids[static_cast<size_t>(v)]);
+  }
+  for (auto t : ring.triangles) renumbered.triangles.push_back({n - 1 - t[0], n - 1 - t[1], n - 1 - t[2]});
+  CHECK(changed_count(certified.changed(renumbered, renumbered_ids)) == 0);
+
+  // An edge flipped: its two triangles are new, on places that did not move.
+  SurfaceMesh flipped = ring;
+  const auto a = flipped.triangles[0], b = flipped.triangles[1];  // (p, q, r) and (p, r, s) of one quad
+  REQUIRE(a[0] == b[0]);
+  REQUIRE(a[2] == b[1]);
+  flipped.triangles[0] = {a[0], a[1], b[2]};
+  flipped.triangles[1] = {a[1], a[2], b[2]};
+  const std::vector<char> flips = certified.changed(flipped, ids);
+  CHECK(changed_count(flips) == 2);
+  CHECK((flips[0] && flips[1]));
+
+  // Repeated ids certify nothing, and a frame with them is changed throughout.
+  std::vector<long> repeated = ids;
+  repeated[5] = repeated[6];
+  CHECK(CertifiedTriangles(ring, repeated).empty());
+  CHECK(changed_count(certified.changed(ring, repeated)) == static_cast<long>(ring.triangles.size()));
+  CHECK(changed_count(CertifiedTriangles().changed(ring, ids)) == static_cast<long>(ring.triangles.size()));
 }
 
 TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {

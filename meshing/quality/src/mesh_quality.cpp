@@ -263,9 +263,10 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
   tbb::parallel_invoke([&] { grade_triangles(mesh, q); }, [&] { grade_edges(mesh, q); },
                        [&] { grade_vertices(mesh, q); }, [&] { components = surface_components(mesh); },
                        [&] {
+                         const long bound = options.max_box_pairs(static_cast<long>(mesh.triangles.size()));
                          if (exact)
-                           crossing = check_self_intersections(
-                               mesh, options.max_box_pairs(static_cast<long>(mesh.triangles.size())));
+                           crossing = options.changed ? check_changed_self_intersections(mesh, *options.changed, bound)
+                                                      : check_self_intersections(mesh, bound);
                        });
   q.components = static_cast<long>(components.enclosed_volume.size());
   q.euler = q.vertices - q.edges + q.triangles;
@@ -282,6 +283,8 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
     q.self_intersections_checked = !crossing.degenerate && !crossing.over_bound;
     q.self_intersections_over_bound = crossing.over_bound;
     q.self_intersection_box_pairs = crossing.box_pairs;
+    q.self_intersection_triangles_tested =
+        options.changed ? std::count(options.changed->begin(), options.changed->end(), 1) : q.triangles;
     q.self_intersecting_pairs = q.self_intersections_checked ? crossing.pairs : 0;
   }
   return q;

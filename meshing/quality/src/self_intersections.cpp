@@ -4,13 +4,18 @@
 // building one was a tenth of the count). CGAL stays in this file.
 #include "skinmesh/quality/mesh_quality.hpp"
 
+#include "skinmesh/core/error.hpp"
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/box_intersection_d.h>
+#include <Eigen/Geometry>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -178,6 +183,145 @@ SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max
   result.box_pairs = shared.seen;
   result.over_bound = shared.over || result.box_pairs > max_box_pairs;
   for (long c : crossing) result.pairs += c;
+  return result;
+}
+
+namespace {
+
+// Counts the crossing pairs CGAL's box intersection reports, against the
+// shared bound on box pairs (as count_slab).
+struct PairCounter {
+  const SurfaceMesh& mesh;
+  BoxPairs& shared;
+  long crossing = 0, unreported = 0;
+  void operator()(const Box* x, const Box* y) {
+    if (++unreported == 4096) {
+      if (shared.seen.fetch_add(unreported) + unreported > shared.max || shared.over) throw OverBound{};
+      unreported = 0;
+    }
+    crossing += triangles_cross(mesh, mesh.triangles[static_cast<size_t>(x->info())],
+                                mesh.triangles[static_cast<size_t>(y->info())]);
+  }
+};
+
+// Runs one of CGAL's box intersections with a PairCounter; its count, or
+// `over` set past the bound.
+template <class Run>
+long count_pairs(const SurfaceMesh& mesh, BoxPairs& shared, Run run) {
+  PairCounter counter{mesh, shared};
+  try {
+    run(counter);
+    shared.seen += counter.unreported;
+  } catch (const OverBound&) {
+    shared.over = true;
+  }
+  return counter.crossing;
+}
+
+// The unchanged triangles whose boxes may meet a changed one: those in a
+// cell of a uniform grid that a changed box reaches. The cells are twice as
+// wide as the median changed box, so a box reaches a few; all unchanged
+// triangles when the grid would be larger than the changed boxes' count
+// warrants (a few huge boxes).
+std::vector<const Box*> near_changed(const std::vector<Box>& boxes, const std::vector<char>& changed) {
+  std::vector<double> extent;
+  Eigen::AlignedBox3d reach;
+  for (size_t f = 0; f < boxes.size(); ++f)
+    if (changed[f]) {
+      const Box& b = boxes[f];
+      double e = 0;
+      for (int k = 0; k < 3; ++k) e = std::max(e, b.max_coord(k) - b.min_coord(k));
+      extent.push_back(e);
+      reach.extend(Eigen::Vector3d(b.min_coord(0), b.min_coord(1), b.min_coord(2)));
+      reach.extend(Eigen::Vector3d(b.max_coord(0), b.max_coord(1), b.max_coord(2)));
+    }
+  std::vector<const Box*> out;
+  const auto all_unchanged = [&] {
+    for (size_t f = 0; f < boxes.size(); ++f)
+      if (!changed[f]) out.push_back(&boxes[f]);
+    return out;
+  };
+  if (extent.empty()) return out;
+  std::nth_element(extent.begin(), extent.begin() + static_cast<long>(extent.size() / 2), extent.end());
+  const double cell = std::max(2 * extent[extent.size() / 2], 1e-9 * (1 + reach.sizes().maxCoeff()));
+  const Eigen::Array3d lo = reach.min().array();
+  const Eigen::Array3d cells = ((reach.max().array() - lo) / cell).floor() + 1;
+  const double most = 16.0 * static_cast<double>(extent.size()) + 4096;
+  if (!(cells.prod() <= most)) return all_unchanged();
+  const Eigen::Array3i size = cells.cast<int>();
+  std::vector<char> dirty(static_cast<size_t>(size.prod()), 0);
+  // Cell ranges a box meets, clamped to the grid (-1 in `first`: outside it).
+  const auto range = [&](const Box& b, Eigen::Array3i& first, Eigen::Array3i& last) {
+    for (int k = 0; k < 3; ++k) {
+      const double a = std::floor((b.min_coord(k) - lo[k]) / cell), z = std::floor((b.max_coord(k) - lo[k]) / cell);
+      if (z < 0 || a >= size[k]) return false;
+      first[k] = static_cast<int>(std::max(a, 0.0));
+      last[k] = static_cast<int>(std::min(z, static_cast<double>(size[k] - 1)));
+    }
+    return true;
+  };
+  const auto visit = [&](const Box& b, auto on_cell) {
+    Eigen::Array3i first, last;
+    if (!range(b, first, last)) return false;
+    for (int i = first[0]; i <= last[0]; ++i)
+      for (int j = first[1]; j <= last[1]; ++j)
+        for (int k = first[2]; k <= last[2]; ++k)
+          if (on_cell((static_cast<size_t>(i) * static_cast<size_t>(size[1]) + static_cast<size_t>(j)) *
+                          static_cast<size_t>(size[2]) +
+                      static_cast<size_t>(k)))
+            return true;
+    return false;
+  };
+  for (size_t f = 0; f < boxes.size(); ++f)
+    if (changed[f]) visit(boxes[f], [&](size_t c) { return dirty[c] = 1, false; });
+  for (size_t f = 0; f < boxes.size(); ++f)
+    if (!changed[f] && visit(boxes[f], [&](size_t c) { return dirty[c] != 0; })) out.push_back(&boxes[f]);
+  return out;
+}
+
+}  // namespace
+
+// The pairs of two changed triangles (one box self-intersection) and of a
+// changed and an unchanged one near it (one bipartite box intersection),
+// side by side. Pairs of two unchanged triangles are not looked at.
+SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, const std::vector<char>& changed,
+                                                       long max_box_pairs) {
+  if (changed.size() != mesh.triangles.size())
+    contract_error("check_changed_self_intersections: one flag per triangle");
+  SelfIntersectionCount result;
+  std::vector<Box> boxes;
+  boxes.reserve(mesh.triangles.size());
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (changed[f] && degenerate(mesh, mesh.triangles[f])) {
+      result.degenerate = true;
+      return result;
+    }
+    boxes.push_back(box_of(mesh, static_cast<int>(f)));
+  }
+  std::vector<const Box*> among, against;  // the changed boxes, twice: CGAL sorts each range in place
+  for (size_t f = 0; f < boxes.size(); ++f)
+    if (changed[f]) among.push_back(&boxes[f]);
+  against = among;
+  std::vector<const Box*> unchanged = near_changed(boxes, changed);
+  BoxPairs shared;
+  shared.max = max_box_pairs;
+  long both = 0, one = 0;
+  constexpr std::ptrdiff_t kCutoff = 2000;  // as count_slab
+  tbb::parallel_invoke(
+      [&] {
+        both = count_pairs(mesh, shared, [&](PairCounter& c) {
+          CGAL::box_self_intersection_d<CGAL::Sequential_tag>(among.begin(), among.end(), std::ref(c), kCutoff);
+        });
+      },
+      [&] {
+        one = count_pairs(mesh, shared, [&](PairCounter& c) {
+          CGAL::box_intersection_d<CGAL::Sequential_tag>(against.begin(), against.end(), unchanged.begin(),
+                                                         unchanged.end(), std::ref(c), kCutoff);
+        });
+      });
+  result.box_pairs = shared.seen;
+  result.over_bound = shared.over || result.box_pairs > max_box_pairs;
+  result.pairs = both + one;
   return result;
 }
 

@@ -45,6 +45,8 @@ struct GuaranteeOptions {
   double min_angle = 30.0;           // degrees: the bound every triangle's smallest angle must meet
   double on_skin_tolerance = 1e-9;   // Angstrom: largest distance of a vertex from the skin
   SelfIntersectionCheck self_intersections = SelfIntersectionCheck::exact;
+  // Per triangle, changed since a certified frame (GradeOptions::changed); null: every pair tested.
+  const std::vector<char>* changed_triangles = nullptr;
   bool topology = true;              // components, voids and Euler characteristic those of the skin
 };
 

@@ -41,6 +41,9 @@ struct MeshQuality {
   // The exact check stopped at GradeOptions' bound on box pairs: not checked.
   bool self_intersections_over_bound = false;
   long self_intersection_box_pairs = 0;      // pairs of triangles with overlapping boxes examined
+  // Triangles whose pairs the exact check tested: all, or the changed ones
+  // (GradeOptions::changed).
+  long self_intersection_triangles_tested = 0;
   Histogram min_angle_histogram;             // 0-60 degrees, 12 bins
 };
 
@@ -58,6 +61,10 @@ inline constexpr long kMinBoxPairs = 1'000'000;
 struct GradeOptions {
   SelfIntersectionCheck self_intersections = SelfIntersectionCheck::exact;
   double max_box_pairs_per_triangle = kDefaultBoxPairsPerTriangle;
+  // Per triangle, 1 where it changed since a frame whose triangles were all
+  // certified (CertifiedTriangles): only pairs with a changed triangle are
+  // tested (check_changed_self_intersections). Null: every pair.
+  const std::vector<char>* changed = nullptr;
   // The bound in pairs for a mesh of `triangles` triangles.
   long max_box_pairs(long triangles) const;
 };
@@ -74,6 +81,12 @@ struct SelfIntersectionCount {
   bool over_bound = false;  // stopped after max_box_pairs box pairs: no answer
 };
 SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max_box_pairs);
+// The same over the pairs with a `changed` triangle (per triangle, 1 or
+// 0) alone: when the unchanged triangles met only at shared corners in a
+// mesh checked before, where they were (CertifiedTriangles), this is the
+// count over every pair. Degenerate: a changed triangle is.
+SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, const std::vector<char>& changed,
+                                                       long max_box_pairs);
 // The same without a bound: the number of crossing pairs, or -1 when a
 // triangle is degenerate, where the question has no answer.
 long count_self_intersections(const SurfaceMesh& mesh);
