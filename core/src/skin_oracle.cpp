@@ -103,6 +103,53 @@ using SupportMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, k
 using CentreMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxSupport>;
 using AffineMatrix = Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxSupport>;
 
+// Whether the columns of A = [Z; 1^T] (centres relative to x, over a row of
+// ones) are linearly dependent, that is the centres affinely dependent, by
+// full pivoting (rank threshold 1e-10 of the largest pivot); then a kernel
+// direction. Fixed-size at the usual support sizes (1-4 balls).
+struct Dependence {
+  bool singular = false;
+  SupportVector direction;  // when singular: A d = 0, d != 0
+};
+template <class Matrix>
+Dependence dependence_of(const Matrix& A) {
+  Eigen::FullPivLU<Matrix> lu(A);
+  lu.setThreshold(1e-10);
+  Dependence out;
+  out.singular = lu.rank() < A.cols();
+  if (out.singular) out.direction = lu.kernel().col(0);
+  return out;
+}
+Dependence affine_dependence(const AffineMatrix& A) {
+  switch (A.cols()) {
+    case 1: return dependence_of<Eigen::Matrix<double, 4, 1>>(A);
+    case 2: return dependence_of<Eigen::Matrix<double, 4, 2>>(A);
+    case 3: return dependence_of<Eigen::Matrix<double, 4, 3>>(A);
+    case 4: return dependence_of<Eigen::Matrix<double, 4, 4>>(A);
+    default: return dependence_of<AffineMatrix>(A);
+  }
+}
+
+// M x = rhs for the KKT matrix of a support whose centres are affinely
+// independent, which makes M nonsingular (the step below): partial
+// pivoting suffices, and at the usual sizes (a support of 1-4 balls) a
+// fixed-size solve, unrolled, costs a fraction of the general one.
+template <int N>
+SupportVector solve_fixed(const SupportMatrix& M, const SupportVector& rhs) {
+  const Eigen::Matrix<double, N, N> m = M.template topLeftCorner<N, N>();
+  const Eigen::Matrix<double, N, 1> b = rhs.template head<N>();
+  return m.partialPivLu().solve(b);
+}
+SupportVector solve_nonsingular(const SupportMatrix& M, const SupportVector& rhs) {
+  switch (M.rows()) {
+    case 2: return solve_fixed<2>(M, rhs);
+    case 3: return solve_fixed<3>(M, rhs);
+    case 4: return solve_fixed<4>(M, rhs);
+    case 5: return solve_fixed<5>(M, rhs);
+    default: return M.partialPivLu().solve(rhs);
+  }
+}
+
 // The candidate of least objective at a vertex of the simplex (l = e_i):
 // where the active-set solves start.
 int least_phi(const Problem& p, const std::vector<int>& candidates) {
@@ -152,9 +199,8 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates, bool war
     AffineMatrix A(4, k);
     A.topRows(3) = Z;
     A.row(3).setOnes();
-    Eigen::FullPivLU<AffineMatrix> dependence(A);
-    dependence.setThreshold(1e-10);
-    const bool singular = dependence.rank() < k;
+    const Dependence dependence = affine_dependence(A);
+    const bool singular = dependence.singular;
     SupportVector step;
     double mu = 0;
     if (!singular) {
@@ -165,13 +211,13 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates, bool war
       M.block(k, 0, 1, k).setConstant(1.0);
       SupportVector rhs = SupportVector::Zero(k + 1);
       rhs.head(k) = -g;
-      const SupportVector sol = M.fullPivLu().solve(rhs);
+      const SupportVector sol = solve_nonsingular(M, rhs);
       step = sol.head(k);
       mu = sol[k];
     } else {
       // Affinely dependent centres: along a direction d with sum d = 0 and
       // Z d = 0 the objective is linear; go downhill until a weight reaches 0.
-      SupportVector d = dependence.kernel().col(0);
+      SupportVector d = dependence.direction;
       if (g.dot(d) > 0) d = -d;
       step = d * 1e30;  // unbounded along d: the ratio test below stops it
     }
