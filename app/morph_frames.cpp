@@ -190,14 +190,17 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees) {
 }
 
 const std::vector<char>* FrameCrossings::changed(const SurfaceMesh& mesh, const std::vector<long>& ids) {
-  if (options_.skip || options_.pairs != "changed" || certified_.empty()) return nullptr;
-  changed_ = certified_.changed(mesh, ids);
+  if (options_.skip || options_.pairs != "changed") return nullptr;
+  now_ = CertifiedTriangles(mesh, ids);
+  if (certified_.empty()) return nullptr;
+  changed_ = certified_.changed_in(now_);
   return &changed_;
 }
 
-void FrameCrossings::checked(const SurfaceMesh& mesh, const std::vector<long>& ids, bool held) {
+void FrameCrossings::checked(bool held) {
   if (options_.skip || options_.pairs != "changed") return;
-  certified_ = held ? CertifiedTriangles(mesh, ids) : CertifiedTriangles();
+  certified_ = held ? std::move(now_) : CertifiedTriangles();
+  now_ = CertifiedTriangles();
 }
 
 FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, const SkinReference& skin,
@@ -210,7 +213,7 @@ FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, co
   FrameCheck c;
   c.guarantees = check_guarantees(mesh, skin, o);
   c.share_below_bound = share_below(mesh, min_angle);
-  crossings.checked(mesh, ids, c.holds());
+  crossings.checked(c.holds());
   return c;
 }
 

@@ -124,11 +124,11 @@ class FrameCrossings {
   // Per triangle of `mesh` (ids per vertex), the triangles to test: null for all.
   const std::vector<char>* changed(const SurfaceMesh& mesh, const std::vector<long>& ids);
   // After the frame's check: its triangles certified when every guarantee held.
-  void checked(const SurfaceMesh& mesh, const std::vector<long>& ids, bool held);
+  void checked(bool held);
 
  private:
   FrameCrossingOptions options_;
-  CertifiedTriangles certified_;
+  CertifiedTriangles certified_, now_;
   std::vector<char> changed_;
 };
 

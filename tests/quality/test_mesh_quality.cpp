@@ -242,15 +242,15 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   const CertifiedTriangles certified(ring, ids);
   REQUIRE_FALSE(certified.empty());
   const auto changed_count = [](const std::vector<char>& c) { return std::count(c.begin(), c.end(), 1); };
-  CHECK(changed_count(certified.changed(ring, ids)) == 0);
-  CHECK(check_changed_self_intersections(ring, certified.changed(ring, ids), 1'000'000).box_pairs == 0);
+  CHECK(changed_count(certified.changed_in(CertifiedTriangles(ring, ids))) == 0);
+  CHECK(check_changed_self_intersections(ring, certified.changed_in(CertifiedTriangles(ring, ids)), 1'000'000).box_pairs == 0);
 
   SurfaceMesh shaken = ring;
   std::mt19937 random(11);
   std::uniform_real_distribution<double> shake(-0.3, 0.3);
   for (size_t v = 10 * 24; v < 14 * 24; ++v) shaken.vertices[v] += Eigen::Vector3d(shake(random), shake(random), shake(random));
   shaken.vertices[30 * 24] = Eigen::Vector3d(0.5, 0.2, 0.1) - shaken.vertices[30 * 24];  // through the far side
-  const std::vector<char> moved = certified.changed(shaken, ids);
+  const std::vector<char> moved = certified.changed_in(CertifiedTriangles(shaken, ids));
   for (size_t f = 0; f < shaken.triangles.size(); ++f) {
     const auto& t = shaken.triangles[f];
     const bool corner_moved = std::any_of(t.begin(), t.end(), [&](int v) { return shaken.vertices[static_cast<size_t>(v)] != ring.vertices[static_cast<size_t>(v)]; });
@@ -278,7 +278,7 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
     renumbered_ids.push_back(ids[static_cast<size_t>(v)]);
   }
   for (auto t : ring.triangles) renumbered.triangles.push_back({n - 1 - t[0], n - 1 - t[1], n - 1 - t[2]});
-  CHECK(changed_count(certified.changed(renumbered, renumbered_ids)) == 0);
+  CHECK(changed_count(certified.changed_in(CertifiedTriangles(renumbered, renumbered_ids))) == 0);
 
   // An edge flipped: its two triangles are new, on places that did not move.
   SurfaceMesh flipped = ring;
@@ -287,7 +287,7 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   REQUIRE(a[2] == b[1]);
   flipped.triangles[0] = {a[0], a[1], b[2]};
   flipped.triangles[1] = {a[1], a[2], b[2]};
-  const std::vector<char> flips = certified.changed(flipped, ids);
+  const std::vector<char> flips = certified.changed_in(CertifiedTriangles(flipped, ids));
   CHECK(changed_count(flips) == 2);
   CHECK((flips[0] && flips[1]));
 
@@ -295,8 +295,8 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   std::vector<long> repeated = ids;
   repeated[5] = repeated[6];
   CHECK(CertifiedTriangles(ring, repeated).empty());
-  CHECK(changed_count(certified.changed(ring, repeated)) == static_cast<long>(ring.triangles.size()));
-  CHECK(changed_count(CertifiedTriangles().changed(ring, ids)) == static_cast<long>(ring.triangles.size()));
+  CHECK(changed_count(certified.changed_in(CertifiedTriangles(ring, repeated))) == static_cast<long>(ring.triangles.size()));
+  CHECK(changed_count(CertifiedTriangles().changed_in(CertifiedTriangles(ring, ids))) == static_cast<long>(ring.triangles.size()));
 }
 
 TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {

@@ -16,24 +16,32 @@ namespace skinmesh {
 
 class CertifiedTriangles {
  public:
-  CertifiedTriangles() = default;  // nothing certified: every triangle is changed
-  // `mesh` whose every pair of triangles was tested and none crosses; `ids`
-  // per vertex. Ids that repeat certify nothing.
+  CertifiedTriangles() = default;  // no triangles
+  // The triangles of `mesh`, with `ids` per vertex; as certified once
+  // every pair of them was tested and none crosses. Ids that repeat give
+  // no triangles.
   CertifiedTriangles(const SurfaceMesh& mesh, const std::vector<long>& ids);
 
   bool empty() const { return triangles_.empty(); }
-  // Per triangle of `mesh` (ids per vertex): 1 unless its corners' ids
-  // make a certified triangle and each corner is exactly where it was.
-  // Every triangle is changed when `ids` repeat an id.
-  std::vector<char> changed(const SurfaceMesh& mesh, const std::vector<long>& ids) const;
+  // Per triangle of `later` (in its mesh's order): 1 unless its corners'
+  // ids make one of these triangles and each corner is exactly where it
+  // was here. All 1 when either side has no triangles (repeated ids).
+  std::vector<char> changed_in(const CertifiedTriangles& later) const;
 
  private:
   struct Place {
     long id;
     double x, y, z;
+    int vertex;  // in the mesh
   };
-  std::vector<Place> places_;                   // by id
-  std::vector<std::array<long, 3>> triangles_;  // corner ids, each triple ascending; sorted
+  struct Corners {
+    std::array<long, 3> ids;  // ascending
+    int triangle;             // in the mesh
+  };
+  std::vector<Place> places_;        // by id
+  std::vector<Corners> triangles_;   // by ids
+  std::vector<std::array<int, 3>> mesh_triangles_;
+  size_t vertex_count_ = 0;
 };
 
 }  // namespace skinmesh
