@@ -71,20 +71,35 @@ void grade_triangles(const SurfaceMesh& mesh, MeshQuality& q) {
   }
 }
 
-// Edges: how many triangles use each, and in which directions. Every use of
-// an edge as its key and direction, sorted, so that the uses of one edge are
-// neighbours (a hash map of the edges cost more than the rest of the grade).
-void grade_edges(const SurfaceMesh& mesh, MeshQuality& q) {
-  const auto& V = mesh.vertices;
-  q.min_edge = INFINITY;
-  std::vector<uint64_t> uses;  // edge_key << 1 | (used as min -> max); ids < 2^31
-  uses.reserve(mesh.triangles.size() * 3);
+// Every use of an edge as its key and direction (edge_key << 1 | used as
+// min -> max; ids < 2^31), in ascending order: bucketed by the lower end
+// (a counting sort), then each bucket (a dozen uses) sorted, in parallel.
+std::vector<uint64_t> sorted_edge_uses(const SurfaceMesh& mesh) {
+  std::vector<size_t> first(mesh.vertices.size() + 1, 0);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) ++first[static_cast<size_t>(std::min(t[k], t[(k + 1) % 3])) + 1];
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<uint64_t> uses(first.back());
+  std::vector<size_t> fill(first.begin(), first.end() - 1);
   for (const auto& t : mesh.triangles)
     for (int k = 0; k < 3; ++k) {
       const int a = t[k], b = t[(k + 1) % 3];
-      uses.push_back(edge_key(a, b) << 1 | static_cast<uint64_t>(a < b));
+      uses[fill[static_cast<size_t>(std::min(a, b))]++] = edge_key(a, b) << 1 | static_cast<uint64_t>(a < b);
     }
-  tbb::parallel_sort(uses.begin(), uses.end());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.vertices.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      std::sort(uses.begin() + static_cast<long>(first[v]), uses.begin() + static_cast<long>(first[v + 1]));
+  });
+  return uses;
+}
+
+// Edges: how many triangles use each, and in which directions, from their
+// uses in order (sorted_edge_uses: the uses of one edge are neighbours; a
+// hash map of the edges cost more than the rest of the grade).
+void grade_edges(const SurfaceMesh& mesh, MeshQuality& q) {
+  const auto& V = mesh.vertices;
+  q.min_edge = INFINITY;
+  const std::vector<uint64_t> uses = sorted_edge_uses(mesh);
   double sum_edge = 0;
   for (size_t first = 0, next = 0; first < uses.size(); first = next) {
     const uint64_t key = uses[first] >> 1;
