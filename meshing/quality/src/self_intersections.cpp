@@ -125,33 +125,53 @@ size_t owner_slab(const std::vector<double>& cut, const Box& a, const Box& b) {
   return static_cast<size_t>(std::lower_bound(cut.begin(), cut.end(), x) - cut.begin());
 }
 
-// The crossing pairs slab k of `cut`'s slabs owns (CGAL sorts the slab's
-// boxes in place); stops (over set) when the slabs together pass the bound
-// on box pairs.
-long count_slab(const SurfaceMesh& mesh, std::vector<const Box*>& slab, size_t k, const std::vector<double>& cut,
-                BoxPairs& shared) {
-  long crossing = 0, unreported = 0;  // box pairs of this slab not yet added to shared.seen
-  const auto on_pair = [&](const Box* x, const Box* y) {
+// CGAL's cutoff below which a range is scanned instead of split: 2,000, as
+// CGAL's own self-intersection test uses (smaller ones were slower).
+constexpr std::ptrdiff_t kBoxCutoff = 2000;
+
+// Counts the crossing pairs CGAL's box intersection reports, against the
+// shared bound on box pairs; with `cut` not empty, only the pairs slab
+// `slab` owns (owner_slab). Past the bound it throws OverBound.
+struct PairCounter {
+  const SurfaceMesh& mesh;
+  BoxPairs& shared;
+  const std::vector<double>* cut = nullptr;
+  size_t slab = 0;
+  long crossing = 0, unreported = 0;  // box pairs not yet added to shared.seen
+  void operator()(const Box* x, const Box* y) {
     // The shared count is updated in batches: an atomic add per pair would
     // cost more than most pairs' predicates.
     if (++unreported == 4096) {
       if (shared.seen.fetch_add(unreported) + unreported > shared.max || shared.over) throw OverBound{};
       unreported = 0;
     }
-    if (!cut.empty() && owner_slab(cut, *x, *y) != k) return;
-    const auto& a = mesh.triangles[static_cast<size_t>(x->info())];
-    const auto& b = mesh.triangles[static_cast<size_t>(y->info())];
-    crossing += triangles_cross(mesh, a, b);
-  };
-  try {
-    // CGAL's cutoff below which a range is scanned instead of split: 2,000,
-    // as CGAL's own self-intersection test uses (smaller ones were slower).
-    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(slab.begin(), slab.end(), on_pair, std::ptrdiff_t{2000});
-    shared.seen += unreported;
-  } catch (const OverBound&) {
-    shared.over = true;
+    if (cut && !cut->empty() && owner_slab(*cut, *x, *y) != slab) return;
+    crossing += triangles_cross(mesh, mesh.triangles[static_cast<size_t>(x->info())],
+                                mesh.triangles[static_cast<size_t>(y->info())]);
   }
-  return crossing;
+};
+
+// Runs one of CGAL's box intersections with `counter`; its count, or
+// `over` set past the bound.
+template <class Run>
+long count_pairs(PairCounter counter, Run run) {
+  try {
+    run(counter);
+    counter.shared.seen += counter.unreported;
+  } catch (const OverBound&) {
+    counter.shared.over = true;
+  }
+  return counter.crossing;
+}
+
+// The crossing pairs slab k of `cut`'s slabs owns (CGAL sorts the slab's
+// boxes in place); stops (over set) when the slabs together pass the bound
+// on box pairs.
+long count_slab(const SurfaceMesh& mesh, std::vector<const Box*>& slab, size_t k, const std::vector<double>& cut,
+                BoxPairs& shared) {
+  return count_pairs(PairCounter{mesh, shared, &cut, k}, [&](PairCounter& c) {
+    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(slab.begin(), slab.end(), std::ref(c), kBoxCutoff);
+  });
 }
 
 }  // namespace
@@ -188,36 +208,6 @@ SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max
 
 namespace {
 
-// Counts the crossing pairs CGAL's box intersection reports, against the
-// shared bound on box pairs (as count_slab).
-struct PairCounter {
-  const SurfaceMesh& mesh;
-  BoxPairs& shared;
-  long crossing = 0, unreported = 0;
-  void operator()(const Box* x, const Box* y) {
-    if (++unreported == 4096) {
-      if (shared.seen.fetch_add(unreported) + unreported > shared.max || shared.over) throw OverBound{};
-      unreported = 0;
-    }
-    crossing += triangles_cross(mesh, mesh.triangles[static_cast<size_t>(x->info())],
-                                mesh.triangles[static_cast<size_t>(y->info())]);
-  }
-};
-
-// Runs one of CGAL's box intersections with a PairCounter; its count, or
-// `over` set past the bound.
-template <class Run>
-long count_pairs(const SurfaceMesh& mesh, BoxPairs& shared, Run run) {
-  PairCounter counter{mesh, shared};
-  try {
-    run(counter);
-    shared.seen += counter.unreported;
-  } catch (const OverBound&) {
-    shared.over = true;
-  }
-  return counter.crossing;
-}
-
 // The unchanged triangles whose boxes may meet a changed one: those in a
 // cell of a uniform grid that a changed box reaches. The cells are twice as
 // wide as the median changed box, so a box reaches a few; all unchanged
@@ -250,7 +240,7 @@ std::vector<const Box*> near_changed(const std::vector<Box>& boxes, const std::v
   if (!(cells.prod() <= most)) return all_unchanged();
   const Eigen::Array3i size = cells.cast<int>();
   std::vector<char> dirty(static_cast<size_t>(size.prod()), 0);
-  // Cell ranges a box meets, clamped to the grid (-1 in `first`: outside it).
+  // The cells a box meets, clamped to the grid; false when it lies outside.
   const auto range = [&](const Box& b, Eigen::Array3i& first, Eigen::Array3i& last) {
     for (int k = 0; k < 3; ++k) {
       const double a = std::floor((b.min_coord(k) - lo[k]) / cell), z = std::floor((b.max_coord(k) - lo[k]) / cell);
@@ -306,17 +296,16 @@ SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, 
   BoxPairs shared;
   shared.max = max_box_pairs;
   long both = 0, one = 0;
-  constexpr std::ptrdiff_t kCutoff = 2000;  // as count_slab
   tbb::parallel_invoke(
       [&] {
-        both = count_pairs(mesh, shared, [&](PairCounter& c) {
-          CGAL::box_self_intersection_d<CGAL::Sequential_tag>(among.begin(), among.end(), std::ref(c), kCutoff);
+        both = count_pairs(PairCounter{mesh, shared}, [&](PairCounter& c) {
+          CGAL::box_self_intersection_d<CGAL::Sequential_tag>(among.begin(), among.end(), std::ref(c), kBoxCutoff);
         });
       },
       [&] {
-        one = count_pairs(mesh, shared, [&](PairCounter& c) {
+        one = count_pairs(PairCounter{mesh, shared}, [&](PairCounter& c) {
           CGAL::box_intersection_d<CGAL::Sequential_tag>(against.begin(), against.end(), unchanged.begin(),
-                                                         unchanged.end(), std::ref(c), kCutoff);
+                                                         unchanged.end(), std::ref(c), kBoxCutoff);
         });
       });
   result.box_pairs = shared.seen;
