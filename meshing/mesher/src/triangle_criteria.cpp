@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 namespace skinmesh {
 
@@ -41,7 +43,10 @@ std::optional<RestrictedTriangle> restricted_triangle(const SkinComplex& complex
   // normal (r the circumradius): a crossing farther than r is another piece
   // of skin (the far side of a thin void or neck), not this triangle's.
   const double window = std::min(reach, std::sqrt((circumcenter - p0).squaredNorm()));
-  const auto hits = complex.intersect_segment(circumcenter - window * normal, circumcenter + window * normal, hint);
+  // One buffer a thread: a morph judges thousands of triangles a frame, and
+  // a fresh vector each was an eighth of the segment's cost.
+  thread_local std::vector<SegmentCrossing> hits;
+  complex.intersect_segment(circumcenter - window * normal, circumcenter + window * normal, hint, &hits);
   if (hits.empty()) return std::nullopt;
   const auto nearest = std::min_element(hits.begin(), hits.end(), [&](const SegmentCrossing& a, const SegmentCrossing& b) {
     return (a.point - circumcenter).squaredNorm() < (b.point - circumcenter).squaredNorm();
@@ -84,7 +89,13 @@ bool shape_passes(const std::array<Eigen::Vector3d, 3>& corners, double min_angl
   const double circumradius = std::sqrt((circumcenter - p0).squaredNorm());
   const double shortest =
       std::sqrt(std::min({u.squaredNorm(), w.squaredNorm(), (corners[2] - corners[1]).squaredNorm()}));
-  const double max_radius_edge = 1.0 / (2.0 * std::sin(min_angle * M_PI / 180.0));
+  // The bound is the same for every triangle a run judges: its sine is kept.
+  thread_local double last_angle = std::numeric_limits<double>::quiet_NaN(), last_bound = 0;
+  if (!(min_angle == last_angle)) {
+    last_bound = 1.0 / (2.0 * std::sin(min_angle * M_PI / 180.0));
+    last_angle = min_angle;
+  }
+  const double max_radius_edge = last_bound;
   return circumradius <= max_radius_edge * shortest;
 }
 
