@@ -56,18 +56,41 @@ std::vector<char> grow_region(const SurfaceMesh& mesh, const VertexStars& stars,
   return region;
 }
 
-// Per vertex: its PatchRole, or kNone. Two rings of context around the rim
-// give the patch's Delaunay triangulation the neighbours its facets have in
-// the whole frame.
-std::vector<signed char> vertex_roles(const SurfaceMesh& mesh, const VertexStars& stars,
-                                      const std::vector<char>& region) {
-  std::vector<signed char> role(mesh.vertices.size(), kNone);
+// The triangles marked in `region`, ascending.
+std::vector<size_t> marked_triangles(const std::vector<char>& region) {
+  std::vector<size_t> out;
   for (size_t f = 0; f < region.size(); ++f)
-    if (region[f])
-      for (int v : mesh.triangles[f]) role[static_cast<size_t>(v)] = static_cast<signed char>(PatchRole::interior);
+    if (region[f]) out.push_back(f);
+  return out;
+}
+
+// Per vertex of a patch attempt: its PatchRole, or kNone; and the vertices
+// with a role, so that the attempt's passes go over the patch and its
+// context, not over the whole frame (`marked`, ascending once sorted).
+struct Roles {
+  std::vector<signed char> role;
+  std::vector<int> marked;
+  void mark(int v, PatchRole r) {
+    signed char& at = role[static_cast<size_t>(v)];
+    if (at == kNone) marked.push_back(v);
+    at = static_cast<signed char>(r);
+  }
+  void sort() { std::sort(marked.begin(), marked.end()); }
+};
+
+// The roles of a patch on the triangles `in_region` (ascending). Two rings
+// of context around the rim give the patch's Delaunay triangulation the
+// neighbours its facets have in the whole frame.
+Roles vertex_roles(const SurfaceMesh& mesh, const VertexStars& stars, const std::vector<char>& region,
+                   const std::vector<size_t>& in_region) {
+  Roles roles;
+  roles.role.assign(mesh.vertices.size(), kNone);
+  std::vector<signed char>& role = roles.role;
+  for (size_t f : in_region)
+    for (int v : mesh.triangles[f]) roles.mark(v, PatchRole::interior);
+  roles.sort();
   std::vector<int> rim;
-  for (int v = 0; v < static_cast<int>(role.size()); ++v) {
-    if (role[static_cast<size_t>(v)] == kNone) continue;
+  for (int v : roles.marked) {
     bool whole = true;
     stars.each(v, [&](int f) { whole = whole && region[static_cast<size_t>(f)]; });
     if (!whole) {
@@ -81,24 +104,23 @@ std::vector<signed char> vertex_roles(const SurfaceMesh& mesh, const VertexStars
       stars.each(v, [&](int f) {
         for (int w : mesh.triangles[static_cast<size_t>(f)])
           if (role[static_cast<size_t>(w)] == kNone) {
-            role[static_cast<size_t>(w)] = static_cast<signed char>(PatchRole::context);
+            roles.mark(w, PatchRole::context);
             next.push_back(w);
           }
       });
     rim.swap(next);
   }
-  return role;
+  return roles;
 }
 
-double longest_edge(const SurfaceMesh& mesh, const std::vector<char>& region) {
+double longest_edge(const SurfaceMesh& mesh, const std::vector<size_t>& in_region) {
   double longest2 = 0;
-  for (size_t f = 0; f < region.size(); ++f)
-    if (region[f])
-      for (size_t k = 0; k < 3; ++k) {
-        const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(mesh.triangles[f][k])];
-        const Eigen::Vector3d& b = mesh.vertices[static_cast<size_t>(mesh.triangles[f][(k + 1) % 3])];
-        longest2 = std::max(longest2, (a - b).squaredNorm());
-      }
+  for (size_t f : in_region)
+    for (size_t k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(mesh.triangles[f][k])];
+      const Eigen::Vector3d& b = mesh.vertices[static_cast<size_t>(mesh.triangles[f][(k + 1) % 3])];
+      longest2 = std::max(longest2, (a - b).squaredNorm());
+    }
   return std::sqrt(longest2);
 }
 
@@ -128,16 +150,21 @@ CellGrid grid_of_vertices(const SurfaceMesh& mesh, std::vector<int> vertices, co
 // vertex v (an edge length of the region's triangles, add_context), about
 // the diameter of a patch facet's surface Delaunay ball, and no farther
 // than `cap` target lengths at v (infinite: no cap). `reach` gets that
-// distance per vertex (0 off the patch). False, with `role` part-marked, as
-// soon as the patch and its context pass `most` vertices.
+// distance per vertex (0 off the patch). False, with `roles` part-marked,
+// as soon as the patch and its context pass `most` vertices. `roles.marked`
+// is ascending on entry; the context found is appended.
 bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
                         const std::vector<double>& longest, const MeshingOptions& criteria, double cap, size_t most,
-                        std::vector<signed char>& role, std::vector<double>& reach) {
+                        Roles& roles, std::vector<double>& reach) {
   const auto context = static_cast<signed char>(PatchRole::context);
+  const std::vector<signed char>& role = roles.role;
   reach.assign(role.size(), 0.0);
   std::vector<double> reaches;
-  for (size_t v = 0; v < role.size(); ++v) {
-    if (role[v] == kNone || role[v] == context || !(longest[v] > 0)) continue;
+  std::vector<size_t> reaching;  // the patch vertices with a reach, ascending
+  for (int u : roles.marked) {
+    const auto v = static_cast<size_t>(u);
+    if (role[v] == context || !(longest[v] > 0)) continue;
+    reaching.push_back(v);
     reach[v] = 2 * longest[v];
     if (std::isfinite(cap))
       reach[v] = std::min(reach[v], cap * target_edge_length(complex, mesh.vertices[v], mesh.cells[v], criteria));
@@ -148,7 +175,7 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   // can be near it: the grid holds those, not the whole frame.
   Eigen::AlignedBox3d near_box;
   double farthest = 0;
-  for (size_t v = 0; v < role.size(); ++v)
+  for (size_t v : reaching)
     if (reach[v] > 0) {
       near_box.extend(mesh.vertices[v]);
       farthest = std::max(farthest, reach[v]);
@@ -165,34 +192,25 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
   // 27-64 cells, about 3-8 times the volume of their ball.
   std::nth_element(reaches.begin(), reaches.begin() + static_cast<long>(reaches.size() / 2), reaches.end());
   const CellGrid grid = grid_of_vertices(mesh, std::move(outside), near_box, 0.5 * reaches[reaches.size() / 2]);
-  size_t taken = static_cast<size_t>(std::count_if(role.begin(), role.end(), [](signed char r) { return r != kNone; }));
   // Marked at once, each vertex once: gathered in a list first, a vertex
   // came once for every patch vertex near it, and the list could outgrow
   // the rest of the morph.
-  for (size_t v = 0; v < role.size(); ++v) {
+  for (size_t v : reaching) {
     if (!(reach[v] > 0)) continue;
     const Eigen::Vector3d& p = mesh.vertices[v];
     const double reach2 = reach[v] * reach[v];
     grid.each_near(p, reach[v], [&](int w, const Eigen::Vector3d& q) {
-      if ((q - p).squaredNorm() >= reach2) return;
-      signed char& r = role[static_cast<size_t>(w)];
-      if (r == kNone) {
-        r = context;
-        ++taken;
-      }
+      if ((q - p).squaredNorm() < reach2) roles.mark(w, PatchRole::context);
     });
-    if (taken > most) return false;
+    if (roles.marked.size() > most) return false;
   }
   return true;
 }
 
 // Per vertex of the region's triangles, the longest edge of those
 // triangles within `rings` rings of it (0 elsewhere).
-std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vector<char>& region, int rings) {
+std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vector<size_t>& in_region, int rings) {
   std::vector<double> longest(mesh.vertices.size(), 0.0);
-  std::vector<size_t> in_region;
-  for (size_t f = 0; f < region.size(); ++f)
-    if (region[f]) in_region.push_back(f);
   for (size_t f : in_region) {
     const Triangle& t = mesh.triangles[f];
     double edge = 0;
@@ -233,49 +251,59 @@ std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vect
 // reach at each vertex), where this context covers the skin; the reach is
 // at most `local_reach_cap` (PatchPolicy, > 0) times `local_scale` target
 // lengths. `reach` gets the distance per vertex. Returns the largest measure.
+// `roles.marked` is ascending on entry; the context is appended.
 double add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
-                   const std::vector<char>& region, double at_least, double local_scale, double local_reach_cap,
-                   const MeshingOptions& criteria, std::vector<signed char>& role, std::vector<double>& reach) {
+                   const std::vector<size_t>& in_region, double at_least, double local_scale, double local_reach_cap,
+                   const MeshingOptions& criteria, Roles& roles, std::vector<double>& reach) {
   constexpr double kLargeShare = 0.25;       // of the frame's vertices
   constexpr double kCapInTargetLengths = 6;  // dimensionless
   constexpr int kLocalRings = 2;
   std::vector<double> longest;
   double measure = 0;
   if (local_scale > 0) {
-    longest = local_longest_edges(mesh, region, kLocalRings);
-    for (double& l : longest) l *= local_scale;
-    measure = *std::max_element(longest.begin(), longest.end());
-    for (size_t v = 0; v < role.size(); ++v)  // seeds on a newborn component have no edge yet
-      if (role[v] != kNone && !(longest[v] > 0)) longest[v] = measure;
+    // Only the corners of the region's triangles have an edge; all are marked.
+    longest = local_longest_edges(mesh, in_region, kLocalRings);
+    for (int v : roles.marked) {
+      double& l = longest[static_cast<size_t>(v)];
+      l *= local_scale;
+      measure = std::max(measure, l);
+    }
+    for (int v : roles.marked)  // seeds on a newborn component have no edge yet
+      if (!(longest[static_cast<size_t>(v)] > 0)) longest[static_cast<size_t>(v)] = measure;
   }
   if (!(measure > 0)) {
     // A region of seeds alone (a newborn component) takes the mesh's longest edge.
-    measure = std::max(longest_edge(mesh, region), at_least);
-    if (!(measure > 0)) measure = longest_edge(mesh, std::vector<char>(mesh.triangles.size(), 1));
+    measure = std::max(longest_edge(mesh, in_region), at_least);
+    if (!(measure > 0)) {
+      std::vector<size_t> all(mesh.triangles.size());
+      std::iota(all.begin(), all.end(), size_t{0});
+      measure = longest_edge(mesh, all);
+    }
     longest.assign(mesh.vertices.size(), measure);
   }
-  const std::vector<signed char> patch = role;
-  const auto large = static_cast<size_t>(kLargeShare * static_cast<double>(role.size()));
+  const size_t patch = roles.marked.size();
+  const auto large = static_cast<size_t>(kLargeShare * static_cast<double>(roles.role.size()));
   // The local measure's cap grows with it (a stalled patch is tried again reaching farther).
   const double first_cap = local_scale > 0 && local_reach_cap > 0 ? local_scale * local_reach_cap
                                                                  : std::numeric_limits<double>::infinity();
-  if (add_nearby_context(complex, mesh, stars, longest, criteria, first_cap, large, role, reach))
+  if (add_nearby_context(complex, mesh, stars, longest, criteria, first_cap, large, roles, reach))
     return measure;
-  role = patch;  // the first search stopped once it passed a quarter
-  add_nearby_context(complex, mesh, stars, longest, criteria, kCapInTargetLengths, SIZE_MAX, role, reach);
+  // The first search stopped once it passed a quarter: its context is taken back.
+  for (size_t k = patch; k < roles.marked.size(); ++k) roles.role[static_cast<size_t>(roles.marked[k])] = kNone;
+  roles.marked.resize(patch);
+  add_nearby_context(complex, mesh, stars, longest, criteria, kCapInTargetLengths, SIZE_MAX, roles, reach);
   return measure;
 }
 
 // Interior vertices crowded together along a patch edge: the later one goes.
 std::vector<char> crowded_interior(const SkinComplex& complex, const SurfaceMesh& mesh,
-                                   const std::vector<char>& region, const std::vector<signed char>& role,
+                                   const std::vector<size_t>& in_region, const std::vector<signed char>& role,
                                    const MeshingOptions& criteria, double crowded_below) {
   std::vector<char> drop(mesh.vertices.size(), 0);
   auto interior = [&](int v) {
     return role[static_cast<size_t>(v)] == static_cast<signed char>(PatchRole::interior);
   };
-  for (size_t f = 0; f < region.size(); ++f) {
-    if (!region[f]) continue;
+  for (size_t f : in_region) {
     const Triangle& t = mesh.triangles[f];
     for (size_t k = 0; k < 3; ++k) {
       const int a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
@@ -315,40 +343,62 @@ bool star_is_disk(int v, const std::vector<Triangle>& around) {
 // whose triangles (kept ones plus the patch's) are not one disk, and the old
 // corners of the patch triangles around a new point whose star is not a
 // disk; such new points go to `open_new`. Empty when the seam holds. New
-// points are numbered from mesh.vertices.size() on.
+// points are numbered from mesh.vertices.size() on. Only the patch's own
+// vertices (`marks`, ascending) and the new points can fail, so only their
+// stars are gathered.
 std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, const std::vector<char>& region,
-                             const std::vector<Triangle>& fresh, const std::vector<signed char>& role,
-                             const std::vector<char>& drop, std::vector<int>& open_new) {
+                             const std::vector<Triangle>& fresh, const Roles& marks, const std::vector<char>& drop,
+                             std::vector<int>& open_new) {
   const size_t old_vertices = mesh.vertices.size();
-  auto in_patch = [&](size_t v) {
-    return v >= old_vertices || role[v] == static_cast<signed char>(PatchRole::interior) ||
+  const std::vector<signed char>& role = marks.role;
+  auto own = [&](size_t v) {
+    return role[v] == static_cast<signed char>(PatchRole::interior) ||
            role[v] == static_cast<signed char>(PatchRole::boundary);
   };
+  std::vector<int> patch;  // the old vertices of the patch, ascending, then rows for the new points
+  for (int v : marks.marked)
+    if (own(static_cast<size_t>(v))) patch.push_back(v);
   size_t vertices = old_vertices;
   for (const Triangle& t : fresh)
     for (int v : t) vertices = std::max(vertices, static_cast<size_t>(v) + 1);
-  // The triangles around each patch vertex (the patch's, then the kept
-  // ones), in compressed rows: `first[v]` to `first[v + 1]` in `around`.
-  std::vector<int> first(vertices + 1, 0);
-  for (const Triangle& t : fresh)
-    for (int v : t) ++first[static_cast<size_t>(v) + 1];
-  for (size_t v = 0; v < old_vertices; ++v)
-    if (in_patch(v))
-      stars.each(static_cast<int>(v), [&](int f) { first[v + 1] += !region[static_cast<size_t>(f)]; });
-  for (size_t v = 1; v <= vertices; ++v) first[v] += first[v - 1];
+  const size_t rows = patch.size() + (vertices - old_vertices);
+  // The row of vertex v: its place in `patch`, or after them for a new
+  // point; -1 for an old vertex off the patch (context), whose star is not judged.
+  const auto row_of = [&](int v) -> long {
+    const auto u = static_cast<size_t>(v);
+    if (u >= old_vertices) return static_cast<long>(patch.size() + (u - old_vertices));
+    const auto it = std::lower_bound(patch.begin(), patch.end(), v);
+    return it != patch.end() && *it == v ? it - patch.begin() : -1;
+  };
+  const auto vertex_of = [&](size_t row) {
+    return row < patch.size() ? patch[row] : static_cast<int>(old_vertices + (row - patch.size()));
+  };
+  // The triangles around each row's vertex (the patch's, then the kept
+  // ones), in compressed rows: `first[r]` to `first[r + 1]` in `around`.
+  std::vector<int> first(rows + 1, 0);
+  std::vector<std::array<long, 3>> rows_of(fresh.size());
+  for (size_t f = 0; f < fresh.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      rows_of[f][k] = row_of(fresh[f][k]);
+      if (rows_of[f][k] >= 0) ++first[static_cast<size_t>(rows_of[f][k]) + 1];
+    }
+  for (size_t r = 0; r < patch.size(); ++r)
+    stars.each(patch[r], [&](int f) { first[r + 1] += !region[static_cast<size_t>(f)]; });
+  for (size_t r = 1; r <= rows; ++r) first[r] += first[r - 1];
   std::vector<Triangle> around(static_cast<size_t>(first.back()));
   std::vector<int> fill(first.begin(), first.end() - 1);
-  for (const Triangle& t : fresh)
-    for (int v : t) around[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
-  for (size_t v = 0; v < old_vertices; ++v)
-    if (in_patch(v))
-      stars.each(static_cast<int>(v), [&](int f) {
-        if (!region[static_cast<size_t>(f)]) around[static_cast<size_t>(fill[v]++)] = mesh.triangles[static_cast<size_t>(f)];
-      });
+  for (size_t f = 0; f < fresh.size(); ++f)
+    for (long r : rows_of[f])
+      if (r >= 0) around[static_cast<size_t>(fill[static_cast<size_t>(r)]++)] = fresh[f];
+  for (size_t r = 0; r < patch.size(); ++r)
+    stars.each(patch[r], [&](int f) {
+      if (!region[static_cast<size_t>(f)]) around[static_cast<size_t>(fill[r]++)] = mesh.triangles[static_cast<size_t>(f)];
+    });
   std::vector<int> faults;
   std::vector<Triangle> star;
-  for (size_t v = 0; v < vertices; ++v) {
-    const auto from = around.begin() + first[v], to = around.begin() + first[v + 1];
+  for (size_t r = 0; r < rows; ++r) {
+    const auto v = static_cast<size_t>(vertex_of(r));
+    const auto from = around.begin() + first[r], to = around.begin() + first[r + 1];
     // an interior vertex may go; a rim vertex has kept triangles
     if (from == to) {
       if (v < old_vertices && role[v] == static_cast<signed char>(PatchRole::boundary) && !drop[v])
@@ -356,7 +406,7 @@ std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, 
       continue;
     }
     star.assign(from, to);
-    if (!in_patch(v) || star_is_disk(static_cast<int>(v), star)) continue;
+    if (star_is_disk(static_cast<int>(v), star)) continue;
     if (v < old_vertices) faults.push_back(static_cast<int>(v));
     else open_new.push_back(static_cast<int>(v));
     for (const Triangle& t : star)
@@ -409,13 +459,13 @@ namespace {
 
 // The patch's vertices and context as samples for mesh_patch; `index`
 // gets each sample's vertex in the mesh.
-std::vector<SkinSample> patch_samples(const SurfaceMesh& mesh, const std::vector<signed char>& role,
-                                      const std::vector<char>& drop, std::vector<PatchRole>& roles,
-                                      std::vector<int>& index) {
+std::vector<SkinSample> patch_samples(const SurfaceMesh& mesh, const Roles& marks, const std::vector<char>& drop,
+                                      std::vector<PatchRole>& roles, std::vector<int>& index) {
+  const std::vector<signed char>& role = marks.role;
   std::vector<SkinSample> samples;
-  for (int v = 0; v < static_cast<int>(role.size()); ++v) {
+  for (int v : marks.marked) {  // ascending
     const auto u = static_cast<size_t>(v);
-    if (role[u] == kNone || drop[u]) continue;
+    if (drop[u]) continue;
     samples.push_back({mesh.vertices[u], mesh.cells[u]});
     roles.push_back(static_cast<PatchRole>(role[u]));
     index.push_back(v);
@@ -463,7 +513,7 @@ std::vector<Triangle> patch_triangles(const SurfaceMesh& mesh, const VertexStars
 // and context vertices within `reach` times the star's longest edge, added
 // to `faults`: the missing triangles of such a star have a context corner
 // (PatchPolicy::open_star_reach).
-void add_near_open_stars(const SurfaceMesh& mesh, const std::vector<signed char>& role,
+void add_near_open_stars(const SurfaceMesh& mesh, const Roles& marks,
                          const std::vector<SkinSample>& added, const std::vector<Triangle>& fresh,
                          const std::vector<int>& open_new, double reach, std::vector<int>& faults) {
   if (open_new.empty() || !(reach > 0)) return;
@@ -480,13 +530,9 @@ void add_near_open_stars(const SurfaceMesh& mesh, const std::vector<signed char>
       if (it == longest.end()) continue;
       it->second = std::max({it->second, (at(t[k]) - at(t[(k + 1) % 3])).norm(), (at(t[k]) - at(t[(k + 2) % 3])).norm()});
     }
-  std::vector<int> near;  // the patch's and the context's vertices
+  std::vector<int> near = marks.marked;  // the patch's and the context's vertices, ascending
   Eigen::AlignedBox3d box;
-  for (size_t v = 0; v < n; ++v)
-    if (role[v] != kNone) {
-      near.push_back(static_cast<int>(v));
-      box.extend(mesh.vertices[v]);
-    }
+  for (int v : near) box.extend(mesh.vertices[static_cast<size_t>(v)]);
   double widest = 0;
   for (const auto& entry : longest) widest = std::max(widest, reach * entry.second);
   if (near.empty() || !(widest > 0)) return;
@@ -557,17 +603,19 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
                   const std::vector<char>& region, std::pair<size_t, size_t> seeds, const SoFar& so_far,
                   const MeshingOptions& repair, const MeshingOptions& accept, const LocalRepairOptions& options) {
   Attempt a;
-  std::vector<signed char> role = vertex_roles(mesh, stars, region);
+  const std::vector<size_t> in_region = marked_triangles(region);
+  Roles marks = vertex_roles(mesh, stars, region, in_region);
   for (size_t v = seeds.first; v < seeds.second; ++v)
-    if (stars.empty(static_cast<int>(v))) role[v] = static_cast<signed char>(PatchRole::interior);
+    if (stars.empty(static_cast<int>(v))) marks.mark(static_cast<int>(v), PatchRole::interior);
+  marks.sort();
   std::vector<double> reach;
-  a.reach_measure =
-      add_context(complex, mesh, stars, region, so_far.reach_measure, so_far.local_scale,
-                  options.policy.local_reach_cap, accept, role, reach);
-  const std::vector<char> drop = crowded_interior(complex, mesh, region, role, accept, options.crowded_below);
+  a.reach_measure = add_context(complex, mesh, stars, in_region, so_far.reach_measure, so_far.local_scale,
+                                options.policy.local_reach_cap, accept, marks, reach);
+  marks.sort();
+  const std::vector<char> drop = crowded_interior(complex, mesh, in_region, marks.role, accept, options.crowded_below);
   std::vector<PatchRole> roles;
   std::vector<int> index;
-  const std::vector<SkinSample> samples = patch_samples(mesh, role, drop, roles, index);
+  const std::vector<SkinSample> samples = patch_samples(mesh, marks, drop, roles, index);
   // Nearly the whole frame: no faults, so the caller remeshes it whole.
   if (static_cast<double>(samples.size()) > options.policy.max_sample_share * static_cast<double>(mesh.vertices.size())) {
     a.failed_because = "the patch took nearly the whole frame (" + std::to_string(samples.size()) + " of " +
@@ -591,8 +639,8 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   a.meshed = true;
   a.fresh = patch_triangles(mesh, stars, region, patch, index);
   a.added = std::move(patch.added);
-  a.faults = seam_faults(mesh, stars, region, a.fresh, role, drop, a.open_new);
-  add_near_open_stars(mesh, role, a.added, a.fresh, a.open_new, options.policy.open_star_reach, a.faults);
+  a.faults = seam_faults(mesh, stars, region, a.fresh, marks, drop, a.open_new);
+  add_near_open_stars(mesh, marks, a.added, a.fresh, a.open_new, options.policy.open_star_reach, a.faults);
   const size_t seam = a.faults.size();
   a.bad = failing_fresh(complex, mesh, a.added, a.fresh, accept);
   const std::vector<char>& bad = a.bad;
@@ -683,6 +731,37 @@ std::vector<int> open_stars(const SurfaceMesh& mesh, const VertexStars& stars, c
     around.clear();
     stars.each(v, [&](int f) { around.push_back(mesh.triangles[static_cast<size_t>(f)]); });
     if (!star_is_disk(v, around)) open.push_back(v);
+  }
+  return open;
+}
+
+// open_stars without a VertexStars of the whole mesh: the triangles around
+// the touched vertices alone, gathered in one pass over the triangles.
+std::vector<int> open_stars(const SurfaceMesh& mesh, const std::vector<char>& touched) {
+  std::vector<int> marked;  // ascending
+  for (size_t v = 0; v < touched.size(); ++v)
+    if (touched[v]) marked.push_back(static_cast<int>(v));
+  if (marked.empty()) return {};
+  const auto row_of = [&](int v) {
+    return static_cast<size_t>(std::lower_bound(marked.begin(), marked.end(), v) - marked.begin());
+  };
+  const auto is_touched = [&](int v) { return static_cast<size_t>(v) < touched.size() && touched[static_cast<size_t>(v)]; };
+  std::vector<int> first(marked.size() + 1, 0);
+  for (const Triangle& t : mesh.triangles)
+    for (int v : t)
+      if (is_touched(v)) ++first[row_of(v) + 1];
+  for (size_t r = 1; r < first.size(); ++r) first[r] += first[r - 1];
+  std::vector<Triangle> around(static_cast<size_t>(first.back()));
+  std::vector<int> fill(first.begin(), first.end() - 1);
+  for (const Triangle& t : mesh.triangles)
+    for (int v : t)
+      if (is_touched(v)) around[static_cast<size_t>(fill[row_of(v)]++)] = t;
+  std::vector<int> open;
+  std::vector<Triangle> star;
+  for (size_t r = 0; r < marked.size(); ++r) {
+    if (first[r] == first[r + 1]) continue;
+    star.assign(around.begin() + first[r], around.begin() + first[r + 1]);
+    if (!star_is_disk(marked[r], star)) open.push_back(marked[r]);
   }
   return open;
 }
@@ -937,8 +1016,7 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
       if (all_in) faults_after_all_in(mesh, *stars, a, before, placed, touched, faults);
     }
     if (a.faults.empty()) {
-      if (std::find(touched.begin(), touched.end(), 1) != touched.end() &&
-          !open_stars(mesh, VertexStars(mesh), touched).empty()) {
+      if (!open_stars(mesh, touched).empty()) {
         out.failed_because = "a vertex the patch's attempts touched has triangles that are not one disk";
         return out;
       }
