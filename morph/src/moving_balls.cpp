@@ -323,16 +323,31 @@ struct CellMap {
   double scale = 1;
 };
 
-// The maps of the cells of `from` that `cells` (per vertex) name; the others stay default.
-std::vector<CellMap> cell_maps(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
-                               const std::vector<char>& quiet, const std::vector<int>& cells) {
-  std::vector<char> used(from.cells().size(), 0);
-  for (int c : cells) used[static_cast<size_t>(c)] = 1;
-  std::vector<CellMap> maps(used.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, used.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t c = r.begin(); c != r.end(); ++c) {
-      if (!used[c]) continue;
-      CellMap& m = maps[c];
+// The maps of the cells of `from` that vertices lie in, one per such cell:
+// a frame's vertices lie in a fraction of the cells, and a map for every
+// cell of the complex is megabytes to fill every step on 3,000 atoms.
+struct CellMaps {
+  std::vector<int> slot;  // per cell of `from`: its map in `maps`, or -1
+  std::vector<CellMap> maps;
+  const CellMap& of(int cell) const { return maps[static_cast<size_t>(slot[static_cast<size_t>(cell)])]; }
+};
+
+CellMaps cell_maps(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
+                   const std::vector<char>& quiet, const std::vector<int>& cells) {
+  CellMaps out;
+  out.slot.assign(from.cells().size(), -1);
+  std::vector<int> used;  // the cells with a vertex, ascending
+  for (int c : cells) out.slot[static_cast<size_t>(c)] = 0;
+  for (size_t c = 0; c < out.slot.size(); ++c)
+    if (out.slot[c] == 0) {
+      out.slot[c] = static_cast<int>(used.size());
+      used.push_back(static_cast<int>(c));
+    }
+  out.maps.resize(used.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, used.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const auto c = static_cast<size_t>(used[k]);
+      CellMap& m = out.maps[k];
       const MixedCell& c0 = from.cell(static_cast<int>(c));
       m.persisting = to.find_cell(c0.balls);
       if (m.persisting < 0) continue;
@@ -348,7 +363,7 @@ std::vector<CellMap> cell_maps(const SkinComplex& from, const SkinComplex& to, c
       m.scale = std::sqrt(ratio);
     }
   });
-  return maps;
+  return out;
 }
 
 // One vertex from the skin of `from` onto the skin of `to`: by its cell's
@@ -786,13 +801,20 @@ const MorphFrame& MovingBalls::Impl::advance_to(std::vector<Ball> balls, double 
   finish_ahead();  // inside the call, so that the frame's seconds hold all its work
   FrameStats& s = frame_.stats;
   s.steps = steps;
+  // Each kept vertex's move (-1: a new id), in parallel; then counted.
+  std::vector<double> kept_move(frame_.ids.size(), -1.0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, kept_move.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const int found = vertex_with_id(was, frame_.ids[v]);
+      if (found >= 0) kept_move[v] = (frame_.mesh.vertices[v] - before[static_cast<size_t>(found)]).norm();
+    }
+  });
   long kept = 0;
-  for (size_t v = 0; v < frame_.ids.size(); ++v) {
-    const int found = vertex_with_id(was, frame_.ids[v]);
-    if (found < 0) continue;
-    ++kept;
-    s.max_kept_move = std::max(s.max_kept_move, (frame_.mesh.vertices[v] - before[static_cast<size_t>(found)]).norm());
-  }
+  for (double move : kept_move)
+    if (move >= 0) {
+      ++kept;
+      s.max_kept_move = std::max(s.max_kept_move, move);
+    }
   s.vertices = static_cast<long>(frame_.mesh.vertices.size());
   s.triangles = static_cast<long>(frame_.mesh.triangles.size());
   s.ids_kept = s.vertices > 0 ? static_cast<double>(kept) / static_cast<double>(s.vertices) : 0.0;
@@ -833,10 +855,10 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   const std::vector<Continuity> reach = continuity_bounds(complex_, next, moved, options_.continuity);
   const size_t n = moved.vertices.size();
   std::vector<VertexFate> fates(n);
-  const std::vector<CellMap> maps = cell_maps(complex_, next, rotations, quiet, moved.cells);
+  const CellMaps maps = cell_maps(complex_, next, rotations, quiet, moved.cells);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
-      fates[v] = move_vertex(complex_, next, maps[static_cast<size_t>(moved.cells[v])], moved.vertices[v], moved.cells[v]);
+      fates[v] = move_vertex(complex_, next, maps.of(moved.cells[v]), moved.vertices[v], moved.cells[v]);
       if (fates[v] == VertexFate::moved || fates[v] == VertexFate::relocated)
         moved.normals[v] = next.evaluate(moved.vertices[v], moved.cells[v]).gradient.normalized();
     }
@@ -920,16 +942,22 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   build_ahead();  // when the repair did not start it
   // Ids mean continuous motion (moving_balls.hpp): a vertex that
   // moved farther in the step than its bound, by transport, relaxation,
-  // an edit or a remesh, is another point of the skin and takes a new id.
-  for (size_t v = 0; v < frame_.ids.size(); ++v) {
-    const int found = vertex_with_id(index_before, frame_.ids[v]);
-    if (found < 0) continue;
-    const Continuity& c = reach[static_cast<size_t>(found)];
-    if ((frame_.mesh.vertices[v] - c.from).norm() > c.bound) {
+  // an edit or a remesh, is another point of the skin and takes a new id
+  // (found in parallel, handed out in vertex order).
+  std::vector<char> jumped(frame_.ids.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, jumped.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const int found = vertex_with_id(index_before, frame_.ids[v]);
+      if (found < 0) continue;
+      const Continuity& c = reach[static_cast<size_t>(found)];
+      jumped[v] = (frame_.mesh.vertices[v] - c.from).norm() > c.bound;
+    }
+  });
+  for (size_t v = 0; v < jumped.size(); ++v)
+    if (jumped[v]) {
       frame_.ids[v] = next_id_++;
       ++s.reidentified;
     }
-  }
   complex_ = std::move(next);
   topology_ = topology;
   critical_ = std::move(critical);
