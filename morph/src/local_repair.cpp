@@ -200,7 +200,7 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
     const Eigen::Vector3d& p = mesh.vertices[v];
     const double reach2 = reach[v] * reach[v];
     grid.each_near(p, reach[v], [&](int w, const Eigen::Vector3d& q) {
-      if ((q - p).squaredNorm() < reach2) roles.mark(w, PatchRole::context);
+      if ((q - p).squaredNorm() < reach2 && role[static_cast<size_t>(w)] == kNone) roles.mark(w, PatchRole::context);
     });
     if (roles.marked.size() > most) return false;
   }
