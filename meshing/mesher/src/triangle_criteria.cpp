@@ -44,7 +44,7 @@ std::optional<RestrictedTriangle> restricted_triangle(const SkinComplex& complex
   // of skin (the far side of a thin void or neck), not this triangle's.
   const double window = std::min(reach, std::sqrt((circumcenter - p0).squaredNorm()));
   // One buffer a thread: a morph judges thousands of triangles a frame, and
-  // a fresh vector each was an eighth of the segment's cost.
+  // allocating a vector for each costs about an eighth of the segment's walk.
   thread_local std::vector<SegmentCrossing> hits;
   complex.intersect_segment(circumcenter - window * normal, circumcenter + window * normal, hint, &hits);
   if (hits.empty()) return std::nullopt;
