@@ -146,16 +146,17 @@ CellGrid grid_of_vertices(const SurfaceMesh& mesh, std::vector<int> vertices, co
 // Without them the Voronoi edge of a patch facet runs on across the gap, its
 // restricted point lies on the other sheet, and refinement meshes that sheet
 // a second time: the repair fails (a wrong topology, or too many points)
-// and the whole frame is remeshed. Near: within twice `longest[v]` of patch
-// vertex v (an edge length of the region's triangles, add_context), about
-// the diameter of a patch facet's surface Delaunay ball, and no farther
-// than `cap` target lengths at v (infinite: no cap). `reach` gets that
+// and the whole frame is remeshed. Near: within `times` `longest[v]` of
+// patch vertex v (an edge length of the region's triangles, add_context;
+// PatchPolicy::context_reach), about the diameter of a patch facet's
+// surface Delaunay ball, and no farther than `cap` target lengths at v
+// (infinite: no cap). `reach` gets that
 // distance per vertex (0 off the patch). False, with `roles` part-marked,
 // as soon as the patch and its context pass `most` vertices. `roles.marked`
 // is ascending on entry; the context found is appended.
 bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
-                        const std::vector<double>& longest, const MeshingOptions& criteria, double cap, size_t most,
-                        Roles& roles, std::vector<double>& reach) {
+                        const std::vector<double>& longest, double times, const MeshingOptions& criteria, double cap,
+                        size_t most, Roles& roles, std::vector<double>& reach) {
   const auto context = static_cast<signed char>(PatchRole::context);
   const std::vector<signed char>& role = roles.role;
   reach.assign(role.size(), 0.0);
@@ -165,7 +166,7 @@ bool add_nearby_context(const SkinComplex& complex, const SurfaceMesh& mesh, con
     const auto v = static_cast<size_t>(u);
     if (role[v] == context || !(longest[v] > 0)) continue;
     reaching.push_back(v);
-    reach[v] = 2 * longest[v];
+    reach[v] = times * longest[v];
     if (std::isfinite(cap))
       reach[v] = std::min(reach[v], cap * target_edge_length(complex, mesh.vertices[v], mesh.cells[v], criteria));
     reaches.push_back(reach[v]);
@@ -254,7 +255,7 @@ std::vector<double> local_longest_edges(const SurfaceMesh& mesh, const std::vect
 // `roles.marked` is ascending on entry; the context is appended.
 double add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const VertexStars& stars,
                    const std::vector<size_t>& in_region, double at_least, double local_scale, double local_reach_cap,
-                   const MeshingOptions& criteria, Roles& roles, std::vector<double>& reach) {
+                   double context_reach, const MeshingOptions& criteria, Roles& roles, std::vector<double>& reach) {
   constexpr double kLargeShare = 0.25;       // of the frame's vertices
   constexpr double kCapInTargetLengths = 6;  // dimensionless
   constexpr int kLocalRings = 2;
@@ -286,12 +287,13 @@ double add_context(const SkinComplex& complex, const SurfaceMesh& mesh, const Ve
   // The local measure's cap grows with it (a stalled patch is tried again reaching farther).
   const double first_cap = local_scale > 0 && local_reach_cap > 0 ? local_scale * local_reach_cap
                                                                  : std::numeric_limits<double>::infinity();
-  if (add_nearby_context(complex, mesh, stars, longest, criteria, first_cap, large, roles, reach))
+  if (add_nearby_context(complex, mesh, stars, longest, context_reach, criteria, first_cap, large, roles, reach))
     return measure;
   // The first search stopped once it passed a quarter: its context is taken back.
   for (size_t k = patch; k < roles.marked.size(); ++k) roles.role[static_cast<size_t>(roles.marked[k])] = kNone;
   roles.marked.resize(patch);
-  add_nearby_context(complex, mesh, stars, longest, criteria, kCapInTargetLengths, SIZE_MAX, roles, reach);
+  add_nearby_context(complex, mesh, stars, longest, context_reach, criteria, kCapInTargetLengths, SIZE_MAX, roles,
+                     reach);
   return measure;
 }
 
@@ -610,7 +612,7 @@ Attempt try_patch(const SkinComplex& complex, const SurfaceMesh& mesh, const Ver
   marks.sort();
   std::vector<double> reach;
   a.reach_measure = add_context(complex, mesh, stars, in_region, so_far.reach_measure, so_far.local_scale,
-                                options.policy.local_reach_cap, accept, marks, reach);
+                                options.policy.local_reach_cap, options.policy.context_reach, accept, marks, reach);
   marks.sort();
   const std::vector<char> drop = crowded_interior(complex, mesh, in_region, marks.role, accept, options.crowded_below);
   std::vector<PatchRole> roles;

@@ -326,6 +326,23 @@ TEST_CASE("local repair: the local context reaches at most local_reach_cap targe
   check_patched(f, capped);
 }
 
+TEST_CASE("local repair: the context reaches context_reach times the local measure", "[morph]") {
+  // The strand's last 53 atoms turned by 3 degrees (as above). With 1.5
+  // instead of 2 the patch's Delaunay triangulation takes fewer context
+  // vertices an attempt and still makes a frame that holds the guarantees.
+  TurnedStrand f = turned_strand(540, 3);
+  f.options.policy.retry_around_faults = true;
+  f.options.policy.local_reach_cap = 6;
+  const detail::RepairResult wide = patched_with(f, &PatchPolicy::context_reach, 2.0);
+  const detail::RepairResult near = patched_with(f, &PatchPolicy::context_reach, 1.5);
+  REQUIRE(wide.ok);
+  REQUIRE(near.ok);
+  INFO("context vertices: 1.5 " << near.context_vertices << " over " << near.attempts << " attempts, 2 "
+                                << wide.context_vertices << " over " << wide.attempts);
+  CHECK(near.context_vertices * wide.attempts < wide.context_vertices * near.attempts);
+  check_patched(f, near);
+}
+
 TEST_CASE("local repair: a patch that fails is tried once more from the start with wider_rings more rings", "[morph]") {
   SECTION("allowed one attempt a round, the patch fails, and its second round meshes a wider region") {
     // The strand's last 32 atoms turned by 5 degrees need more than one

@@ -118,6 +118,15 @@ struct PatchPolicy {
   // it, and the context then holds thousands of vertices far from where
   // anything is meshed. Moving atoms take 6 (moving_balls.hpp).
   double local_reach_cap = 0;
+  // The context's reach: at each patch vertex, the mesh vertices within
+  // this times the measure there (the longest region edge nearby, above)
+  // join the patch's Delaunay triangulation (dimensionless). It should span
+  // the surface Delaunay ball of a facet at the vertex, whose diameter is
+  // about the facet's longest edge over the sine of its largest angle: 2
+  // spans largest angles up to 150 degrees, 1.5 up to 138. A smaller reach
+  // inserts fewer context points at every attempt. Moving atoms take 1.5
+  // (moving_balls.hpp).
+  double context_reach = 2.0;
 };
 
 struct RepairPolicy {
