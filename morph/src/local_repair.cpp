@@ -447,12 +447,30 @@ long component_count(const SurfaceMesh& mesh) {
   return components;
 }
 
-// Drops the vertices no triangle uses and renumbers; origin maps each
-// vertex back to the mesh before (or -1).
-void compact(const SurfaceMesh& merged, size_t old_vertices, RepairResult& out) {
-  std::vector<int> kept_from;
-  out.mesh = used_part(merged, {}, kept_from);
-  for (int v : kept_from) out.origin.push_back(static_cast<size_t>(v) < old_vertices ? v : -1);
+// Drops the vertices no triangle uses and renumbers, in place (a frame's
+// arrays are not copied again); origin maps each vertex back to the mesh
+// before (or -1).
+void compact(SurfaceMesh&& merged, size_t old_vertices, RepairResult& out) {
+  std::vector<int> renumber(merged.vertices.size(), -1);
+  for (const Triangle& t : merged.triangles)
+    for (int v : t) renumber[static_cast<size_t>(v)] = 0;
+  size_t kept = 0;
+  out.origin.clear();
+  for (size_t v = 0; v < renumber.size(); ++v) {
+    if (renumber[v] < 0) continue;
+    renumber[v] = static_cast<int>(kept);
+    merged.vertices[kept] = merged.vertices[v];
+    merged.cells[kept] = merged.cells[v];
+    merged.normals[kept] = merged.normals[v];
+    out.origin.push_back(v < old_vertices ? static_cast<int>(v) : -1);
+    ++kept;
+  }
+  merged.vertices.resize(kept);
+  merged.cells.resize(kept);
+  merged.normals.resize(kept);
+  for (Triangle& t : merged.triangles)
+    for (int& v : t) v = renumber[static_cast<size_t>(v)];
+  out.mesh = std::move(merged);
 }
 
 }  // namespace
@@ -744,9 +762,9 @@ std::vector<int> open_stars(const SurfaceMesh& mesh, const std::vector<char>& to
   for (size_t v = 0; v < touched.size(); ++v)
     if (touched[v]) marked.push_back(static_cast<int>(v));
   if (marked.empty()) return {};
-  const auto row_of = [&](int v) {
-    return static_cast<size_t>(std::lower_bound(marked.begin(), marked.end(), v) - marked.begin());
-  };
+  std::vector<int> row(touched.size(), -1);
+  for (size_t r = 0; r < marked.size(); ++r) row[static_cast<size_t>(marked[r])] = static_cast<int>(r);
+  const auto row_of = [&](int v) { return static_cast<size_t>(row[static_cast<size_t>(v)]); };
   const auto is_touched = [&](int v) { return static_cast<size_t>(v) < touched.size() && touched[static_cast<size_t>(v)]; };
   std::vector<int> first(marked.size() + 1, 0);
   for (const Triangle& t : mesh.triangles)
@@ -856,7 +874,17 @@ std::vector<SkinSample> points_at_changes(const SkinComplex& complex, const std:
 SurfaceMesh with_seeds_at_changes(const SkinComplex& complex, const SurfaceMesh& mesh,
                                   const std::vector<TopologyChange>& changes) {
   const std::vector<SkinSample> seeds = points_at_changes(complex, changes, false);
-  SurfaceMesh seeded = mesh;
+  // Room for the seeds and the patch's new points (put_in) before the copy:
+  // appending to an exact copy of a frame's arrays would copy them again.
+  const size_t room = seeds.size() + std::max<size_t>(4096, mesh.vertices.size() / 16);
+  SurfaceMesh seeded;
+  seeded.vertices.reserve(mesh.vertices.size() + room);
+  seeded.cells.reserve(mesh.cells.size() + room);
+  seeded.normals.reserve(mesh.normals.size() + room);
+  seeded.vertices = mesh.vertices;
+  seeded.cells = mesh.cells;
+  seeded.normals = mesh.normals;
+  seeded.triangles = mesh.triangles;
   for (const SkinSample& p : seeds) {
     seeded.vertices.push_back(p.point);
     seeded.cells.push_back(p.cell);
@@ -1027,7 +1055,7 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
                              "changes say";
         return out;
       }
-      compact(mesh, given.vertices.size(), out);
+      compact(std::move(mesh), given.vertices.size(), out);
       out.ok = true;
       out.failed_because.clear();  // an earlier attempt's
       return out;

@@ -22,18 +22,9 @@
 #include <memory>
 #include <numeric>
 #include <optional>
-#include <unordered_map>
 
 namespace skinmesh {
 namespace {
-
-struct TupleHash {
-  size_t operator()(const std::array<int, 4>& k) const {
-    size_t h = 1469598103934665603ull;  // FNV-1a over the four ids
-    for (int v : k) h = (h ^ static_cast<size_t>(v + 1)) * 1099511628211ull;
-    return h;
-  }
-};
 
 double radius_of(const Ball& b) { return std::sqrt(std::max(b.weight, 0.0)); }
 
@@ -423,9 +414,18 @@ std::vector<int> inside_critical_cells(const SkinComplex& complex) {
   return out;
 }
 
-std::unordered_map<std::array<int, 4>, int, TupleHash> by_tuple(const SkinComplex& complex, const std::vector<int>& cells) {
-  std::unordered_map<std::array<int, 4>, int, TupleHash> out;
-  for (int c : cells) out.emplace(complex.cell(c).balls, c);
+// The cells of `cells` (inside critical cells of `of`) whose ball tuple is
+// not an inside critical cell of `other`: each looked up by its tuple in
+// `other`'s table (SkinComplex::find_cell).
+std::vector<int> critical_only_in(const SkinComplex& of, const std::vector<int>& cells, const SkinComplex& other,
+                                  const std::vector<int>& other_cells) {
+  std::vector<char> critical(other.cells().size(), 0);
+  for (int c : other_cells) critical[static_cast<size_t>(c)] = 1;
+  std::vector<int> out;
+  for (int c : cells) {
+    const int there = other.find_cell(of.cell(c).balls);
+    if (there < 0 || !critical[static_cast<size_t>(there)]) out.push_back(c);
+  }
   return out;
 }
 
@@ -442,16 +442,10 @@ std::unordered_map<std::array<int, 4>, int, TupleHash> by_tuple(const SkinComple
 void topology_changes(const SkinComplex& from, const std::vector<int>& from_critical, const SkinComplex& to,
                       const std::vector<int>& to_critical, bool same_topology, detail::LocalRepairOptions& local,
                       std::vector<detail::VanishingSphere>& vanished) {
-  const auto before = by_tuple(from, from_critical), after = by_tuple(to, to_critical);
   std::vector<const MixedCell*> gone, came;
-  std::vector<int> came_index;
-  for (const auto& [balls, c] : before)
-    if (!after.count(balls)) gone.push_back(&from.cell(c));
-  for (const auto& [balls, c] : after)
-    if (!before.count(balls)) {
-      came.push_back(&to.cell(c));
-      came_index.push_back(c);
-    }
+  const std::vector<int> came_index = critical_only_in(to, to_critical, from, from_critical);
+  for (int c : critical_only_in(from, from_critical, to, to_critical)) gone.push_back(&from.cell(c));
+  for (int c : came_index) came.push_back(&to.cell(c));
   // A k-cell and a (k+1)-cell having it as a face that appear (or go)
   // together are a cancelling pair of critical points: no change.
   const auto is_face = [](const MixedCell& f, const MixedCell& c) {
@@ -859,8 +853,10 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       fates[v] = move_vertex(complex_, next, maps.of(moved.cells[v]), moved.vertices[v], moved.cells[v]);
+      // The vertex lies in its cell now (its membership was tested, or the
+      // projection ended there): its normal without locating it again.
       if (fates[v] == VertexFate::moved || fates[v] == VertexFate::relocated)
-        moved.normals[v] = next.evaluate(moved.vertices[v], moved.cells[v]).gradient.normalized();
+        moved.normals[v] = next.gradient(moved.cells[v], moved.vertices[v]).normalized();
     }
   });
   // A triangle whose corners all stayed in cells two rings of stillness
