@@ -241,12 +241,12 @@ struct Settled {
   std::vector<char> thinning;
 };
 
-// Where a vertex was before a step, and how far it may move in the step
-// and keep its id: the largest move of its cell's balls plus `continuity`
-// times its longest mesh edge (Angstrom).
+// Where a vertex was before a step, and the largest move of its cell's
+// balls in the step (Angstrom). It may move that far plus `continuity`
+// times its longest mesh edge before the step and keep its id.
 struct Continuity {
   Eigen::Vector3d from;
-  double bound = 0;
+  double balls_moved = 0;
 };
 
 // Per vertex id below `next_id` (ids are handed out in order), its index in
@@ -261,30 +261,7 @@ int vertex_with_id(const std::vector<int>& index, long id) {
   return id >= 0 && id < static_cast<long>(index.size()) ? index[static_cast<size_t>(id)] : -1;
 }
 
-// Per vertex, its longest mesh edge (Angstrom): the lengths in parallel,
-// each triangle's three, then the largest at each end.
-std::vector<double> longest_edges(const SurfaceMesh& mesh) {
-  std::vector<double> length(3 * mesh.triangles.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.triangles.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t f = r.begin(); f != r.end(); ++f)
-      for (size_t k = 0; k < 3; ++k)
-        length[3 * f + k] = (mesh.vertices[static_cast<size_t>(mesh.triangles[f][k])] -
-                             mesh.vertices[static_cast<size_t>(mesh.triangles[f][(k + 1) % 3])])
-                                .norm();
-  });
-  std::vector<double> longest(mesh.vertices.size(), 0.0);
-  for (size_t f = 0; f < mesh.triangles.size(); ++f)
-    for (size_t k = 0; k < 3; ++k) {
-      const size_t a = static_cast<size_t>(mesh.triangles[f][k]), b = static_cast<size_t>(mesh.triangles[f][(k + 1) % 3]);
-      longest[a] = std::max(longest[a], length[3 * f + k]);
-      longest[b] = std::max(longest[b], length[3 * f + k]);
-    }
-  return longest;
-}
-
-std::vector<Continuity> continuity_bounds(const SkinComplex& from, const SkinComplex& to, const SurfaceMesh& mesh,
-                                         double continuity) {
-  const std::vector<double> longest = longest_edges(mesh);
+std::vector<Continuity> continuity_starts(const SkinComplex& from, const SkinComplex& to, const SurfaceMesh& mesh) {
   std::vector<double> ball_moved(from.balls().size());
   for (size_t b = 0; b < ball_moved.size(); ++b) ball_moved[b] = ball_move(from.balls()[b], to.balls()[b]);
   std::vector<Continuity> out(mesh.vertices.size());
@@ -294,10 +271,58 @@ std::vector<Continuity> continuity_bounds(const SkinComplex& from, const SkinCom
       double balls_moved = 0;
       for (int i = 0; i <= cell.dim; ++i)
         balls_moved = std::max(balls_moved, ball_moved[static_cast<size_t>(cell.balls[static_cast<size_t>(i)])]);
-      out[v] = {mesh.vertices[v], balls_moved + continuity * longest[v]};
+      out[v] = {mesh.vertices[v], balls_moved};
     }
   });
   return out;
+}
+
+// Per vertex of the mesh before the step marked in `wanted`, its longest
+// edge among `triangles` (Angstrom; 0 for the others): only the few
+// vertices that moved farther than their balls need it, so it is not
+// worked out for every vertex.
+std::vector<double> longest_edges_of(const std::vector<Continuity>& before,
+                                     const std::vector<std::array<int, 3>>& triangles, const std::vector<char>& wanted) {
+  std::vector<double> longest(before.size(), 0.0);
+  for (const auto& t : triangles)
+    for (size_t k = 0; k < 3; ++k) {
+      const auto a = static_cast<size_t>(t[k]), b = static_cast<size_t>(t[(k + 1) % 3]);
+      if (!wanted[a] && !wanted[b]) continue;
+      const double length = (before[a].from - before[b].from).norm();
+      longest[a] = std::max(longest[a], length);
+      longest[b] = std::max(longest[b], length);
+    }
+  return longest;
+}
+
+// Per vertex of `mesh` (ids `ids`), whether it moved in the step farther
+// than its bound (Continuity) from where its id was before: first against
+// its balls' move alone, then, for the few past that, with `continuity`
+// times its longest edge before the step added (in parallel).
+std::vector<char> jumped_vertices(const SurfaceMesh& mesh, const std::vector<long>& ids,
+                                  const std::vector<Continuity>& before,
+                                  const std::vector<std::array<int, 3>>& triangles_before,
+                                  const std::vector<int>& index_before, double continuity) {
+  std::vector<char> jumped(ids.size(), 0), wanted(before.size(), 0);
+  std::vector<double> moved(ids.size(), 0.0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, ids.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const int found = vertex_with_id(index_before, ids[v]);
+      if (found < 0) continue;
+      const Continuity& c = before[static_cast<size_t>(found)];
+      moved[v] = (mesh.vertices[v] - c.from).norm();
+      wanted[static_cast<size_t>(found)] = moved[v] > c.balls_moved;  // ids are unique: one writer each
+    }
+  });
+  if (std::find(wanted.begin(), wanted.end(), 1) == wanted.end()) return jumped;
+  const std::vector<double> longest = longest_edges_of(before, triangles_before, wanted);
+  for (size_t v = 0; v < ids.size(); ++v) {
+    const int found = vertex_with_id(index_before, ids[v]);
+    if (found < 0 || !wanted[static_cast<size_t>(found)]) continue;
+    const Continuity& c = before[static_cast<size_t>(found)];
+    jumped[v] = moved[v] > c.balls_moved + continuity * longest[static_cast<size_t>(found)];
+  }
+  return jumped;
 }
 
 // How the vertices of one cell of the step before move (docs/math.md
@@ -846,7 +871,8 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   s.seconds_complex += seconds_since(stage);
   stage = Clock::now();
   SurfaceMesh moved = frame_.mesh;
-  const std::vector<Continuity> reach = continuity_bounds(complex_, next, moved, options_.continuity);
+  const std::vector<Continuity> reach = continuity_starts(complex_, next, moved);
+  const std::vector<std::array<int, 3>> triangles_before = moved.triangles;  // as they were: the repair changes them
   const size_t n = moved.vertices.size();
   std::vector<VertexFate> fates(n);
   const CellMaps maps = cell_maps(complex_, next, rotations, quiet, moved.cells);
@@ -940,15 +966,8 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // moved farther in the step than its bound, by transport, relaxation,
   // an edit or a remesh, is another point of the skin and takes a new id
   // (found in parallel, handed out in vertex order).
-  std::vector<char> jumped(frame_.ids.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, jumped.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v) {
-      const int found = vertex_with_id(index_before, frame_.ids[v]);
-      if (found < 0) continue;
-      const Continuity& c = reach[static_cast<size_t>(found)];
-      jumped[v] = (frame_.mesh.vertices[v] - c.from).norm() > c.bound;
-    }
-  });
+  const std::vector<char> jumped =
+      jumped_vertices(frame_.mesh, frame_.ids, reach, triangles_before, index_before, options_.continuity);
   for (size_t v = 0; v < jumped.size(); ++v)
     if (jumped[v]) {
       frame_.ids[v] = next_id_++;
