@@ -226,6 +226,21 @@ detail::RepairResult patched_with(TurnedStrand& f, T PatchPolicy::*setting, T va
   return detail::repair_locally(f.to, f.edited.mesh, f.edited.failing, f.accept, f.accept, f.options);
 }
 
+// The patch with `setting` at `wider` and at `narrower`: both succeed, the
+// narrower takes fewer context vertices an attempt, and its frame holds
+// the guarantees.
+template <class T>
+void fewer_context_with(TurnedStrand& f, T PatchPolicy::*setting, T wider, T narrower) {
+  const detail::RepairResult wide = patched_with(f, setting, wider);
+  const detail::RepairResult narrow = patched_with(f, setting, narrower);
+  REQUIRE(wide.ok);
+  REQUIRE(narrow.ok);
+  INFO("context vertices: " << narrow.context_vertices << " over " << narrow.attempts << " attempts against "
+                            << wide.context_vertices << " over " << wide.attempts);
+  CHECK(narrow.context_vertices * wide.attempts < wide.context_vertices * narrow.attempts);
+  check_patched(f, narrow);
+}
+
 }  // namespace
 
 TEST_CASE("local repair: after an attempt with faults only the pieces that had them are meshed again", "[morph]") {
@@ -298,14 +313,7 @@ TEST_CASE("local repair: a patch first takes a context near each of its vertices
   // its edges near most of its vertices: the local context is smaller, the
   // patch with it succeeds, and the frame it makes holds the guarantees.
   TurnedStrand f = turned_strand(570, 2);
-  const detail::RepairResult whole = patched_with(f, &PatchPolicy::local_context_first, false);
-  const detail::RepairResult local = patched_with(f, &PatchPolicy::local_context_first, true);
-  REQUIRE(whole.ok);
-  REQUIRE(local.ok);
-  INFO("context vertices: local " << local.context_vertices << " over " << local.attempts << " attempts, whole "
-                                  << whole.context_vertices << " over " << whole.attempts);
-  CHECK(local.context_vertices * whole.attempts < whole.context_vertices * local.attempts);
-  check_patched(f, local);
+  fewer_context_with(f, &PatchPolicy::local_context_first, false, true);
 }
 
 TEST_CASE("local repair: the local context reaches at most local_reach_cap target lengths", "[morph]") {
@@ -316,14 +324,7 @@ TEST_CASE("local repair: the local context reaches at most local_reach_cap targe
   // the guarantees.
   TurnedStrand f = turned_strand(540, 3);
   f.options.policy.retry_around_faults = true;
-  const detail::RepairResult uncapped = patched_with(f, &PatchPolicy::local_reach_cap, 0.0);
-  const detail::RepairResult capped = patched_with(f, &PatchPolicy::local_reach_cap, 6.0);
-  REQUIRE(uncapped.ok);
-  REQUIRE(capped.ok);
-  INFO("context vertices: capped " << capped.context_vertices << " over " << capped.attempts << " attempts, uncapped "
-                                   << uncapped.context_vertices << " over " << uncapped.attempts);
-  CHECK(capped.context_vertices * uncapped.attempts < uncapped.context_vertices * capped.attempts);
-  check_patched(f, capped);
+  fewer_context_with(f, &PatchPolicy::local_reach_cap, 0.0, 6.0);
 }
 
 TEST_CASE("local repair: the context reaches context_reach times the local measure", "[morph]") {
@@ -333,14 +334,7 @@ TEST_CASE("local repair: the context reaches context_reach times the local measu
   TurnedStrand f = turned_strand(540, 3);
   f.options.policy.retry_around_faults = true;
   f.options.policy.local_reach_cap = 6;
-  const detail::RepairResult wide = patched_with(f, &PatchPolicy::context_reach, 2.0);
-  const detail::RepairResult near = patched_with(f, &PatchPolicy::context_reach, 1.5);
-  REQUIRE(wide.ok);
-  REQUIRE(near.ok);
-  INFO("context vertices: 1.5 " << near.context_vertices << " over " << near.attempts << " attempts, 2 "
-                                << wide.context_vertices << " over " << wide.attempts);
-  CHECK(near.context_vertices * wide.attempts < wide.context_vertices * near.attempts);
-  check_patched(f, near);
+  fewer_context_with(f, &PatchPolicy::context_reach, 2.0, 1.5);
 }
 
 TEST_CASE("local repair: a patch that fails is tried once more from the start with wider_rings more rings", "[morph]") {
