@@ -297,8 +297,8 @@ std::vector<double> longest_edges_of(const std::vector<Continuity>& before,
 
 // Per vertex of `mesh` (ids `ids`), whether it moved in the step farther
 // than its bound (Continuity) from where its id was before: first against
-// its balls' move alone, then, for the few past that, with `continuity`
-// times its longest edge before the step added (in parallel).
+// its balls' move alone (in parallel), then, for the few past that, with
+// `continuity` times its longest edge before the step added.
 std::vector<char> jumped_vertices(const SurfaceMesh& mesh, const std::vector<long>& ids,
                                   const std::vector<Continuity>& before,
                                   const std::vector<std::array<int, 3>>& triangles_before,
