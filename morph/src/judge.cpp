@@ -45,11 +45,15 @@ namespace {
 // The triangles of `mesh` numbered in `at` judged, their verdicts into `failing`.
 void judge_these(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<size_t>& at,
                  const MeshingOptions& criteria, std::vector<char>& failing) {
-  std::vector<std::array<int, 3>> again;
-  again.reserve(at.size());
-  for (size_t f : at) again.push_back(mesh.triangles[f]);
-  const std::vector<char> verdicts = failing_triangles(complex, mesh, again, criteria);
-  for (size_t k = 0; k < at.size(); ++k) failing[at[k]] = verdicts[k];
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, at.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const std::array<int, 3>& t = mesh.triangles[at[k]];
+      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
+                                                   mesh.vertices[static_cast<size_t>(t[1])],
+                                                   mesh.vertices[static_cast<size_t>(t[2])]};
+      failing[at[k]] = !triangle_passes(complex, corners, mesh.cells[static_cast<size_t>(t[0])], criteria);
+    }
+  });
 }
 
 }  // namespace
@@ -97,24 +101,27 @@ Known known_of(const SurfaceMesh& mesh, const KnownVerdicts& known, const std::a
 // into j.failing, j.settled and j.carried.
 void judge_known(const SkinComplex& complex, const SurfaceMesh& mesh, const MeshingOptions& criteria,
                  const KnownVerdicts& known, Judged& j) {
+  // A carried triangle's shape is judged where its kind is found, in parallel.
   std::vector<Known> kinds(mesh.triangles.size());
+  j.failing.assign(mesh.triangles.size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, kinds.size(), 2048), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t f = r.begin(); f != r.end(); ++f) kinds[f] = known_of(mesh, known, mesh.triangles[f]);
+    for (size_t f = r.begin(); f != r.end(); ++f) {
+      const std::array<int, 3>& t = mesh.triangles[f];
+      kinds[f] = known_of(mesh, known, t);
+      if (kinds[f] == Known::carried)
+        j.failing[f] = !shape_passes({mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
+                                      mesh.vertices[static_cast<size_t>(t[2])]},
+                                     criteria.min_angle);
+    }
   });
   std::vector<size_t> at;
-  j.failing.assign(mesh.triangles.size(), 0);
   for (size_t f = 0; f < kinds.size(); ++f) {
-    const std::array<int, 3>& t = mesh.triangles[f];
-    if (kinds[f] == Known::settled) {
+    if (kinds[f] == Known::settled)
       ++j.settled;
-    } else if (kinds[f] == Known::carried) {
+    else if (kinds[f] == Known::carried)
       ++j.carried;
-      j.failing[f] = !shape_passes({mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
-                                    mesh.vertices[static_cast<size_t>(t[2])]},
-                                   criteria.min_angle);
-    } else {
+    else
       at.push_back(f);
-    }
   }
   judge_these(complex, mesh, at, criteria, j.failing);
 }

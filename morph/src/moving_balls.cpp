@@ -569,18 +569,17 @@ void check_balls(const std::vector<Ball>& balls, const char* what) {
 
 }  // namespace
 
-SkinTopology mesh_topology(const SurfaceMesh& mesh) {
+namespace {
+
+// The distinct edges of `mesh`'s triangles: bucketed by their lower end,
+// each there once per triangle side, counted once per bucket by marking
+// the higher ends already met.
+long distinct_edges(const SurfaceMesh& mesh) {
   const size_t n = mesh.vertices.size();
-  // The edges by their lower end, each there once per triangle side; made
-  // unique below by marking the higher ends already met in the bucket.
   std::vector<int> first(n + 1, 0), higher(mesh.triangles.size() * 3);
-  std::vector<char> used(n, 0);
   for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
-      used[static_cast<size_t>(a)] = 1;
-      ++first[static_cast<size_t>(std::min(a, b)) + 1];
-    }
+    for (int k = 0; k < 3; ++k)
+      ++first[static_cast<size_t>(std::min(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])) + 1];
   std::partial_sum(first.begin(), first.end(), first.begin());
   std::vector<int> fill(first.begin(), first.end() - 1);
   for (const auto& t : mesh.triangles)
@@ -588,8 +587,31 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
       const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
       higher[static_cast<size_t>(fill[static_cast<size_t>(std::min(a, b))]++)] = std::max(a, b);
     }
-  // Components by union-find, each root the least vertex of its set
-  // (parent[x] <= x), so that one pass in vertex order flattens it.
+  long edges = 0;
+  std::vector<int> seen_from(n, -1);  // the lower end whose bucket last held the vertex
+  for (size_t v = 0; v < n; ++v)
+    for (int k = first[v]; k < first[v + 1]; ++k) {
+      const int b = higher[static_cast<size_t>(k)];
+      if (seen_from[static_cast<size_t>(b)] == static_cast<int>(v)) continue;
+      seen_from[static_cast<size_t>(b)] = static_cast<int>(v);
+      ++edges;
+    }
+  return edges;
+}
+
+}  // namespace
+
+SkinTopology mesh_topology(const SurfaceMesh& mesh) {
+  // The edge count (for the Euler characteristic) on another core, the
+  // components and their volumes here: both only read the mesh.
+  long edge_count = 0;
+  tbb::task_group counting;
+  counting.run([&] { edge_count = distinct_edges(mesh); });
+  const size_t n = mesh.vertices.size();
+  std::vector<char> used(n, 0);
+  // Components by union-find over the triangles' corners, each root the
+  // least vertex of its set (parent[x] <= x), so that one pass in vertex
+  // order flattens it.
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   const auto find = [&](int x) {
@@ -597,23 +619,11 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
       x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
     return x;
   };
-  long edge_count = 0;
-  std::vector<int> seen_from(n, -1);  // the lower end whose bucket last held the vertex
-  for (size_t v = 0; v < n; ++v) {
-    int root = -1;
-    for (int k = first[v]; k < first[v + 1]; ++k) {
-      const int b = higher[static_cast<size_t>(k)];
-      if (seen_from[static_cast<size_t>(b)] == static_cast<int>(v)) continue;  // each edge once
-      seen_from[static_cast<size_t>(b)] = static_cast<int>(v);
-      ++edge_count;
-      if (root < 0) root = find(static_cast<int>(v));
-      const int other = find(b);
-      if (other < root) {
-        parent[static_cast<size_t>(root)] = other;
-        root = other;
-      } else if (other > root) {
-        parent[static_cast<size_t>(other)] = root;
-      }
+  for (const auto& t : mesh.triangles) {
+    for (int v : t) used[static_cast<size_t>(v)] = 1;
+    for (size_t k = 1; k < 3; ++k) {
+      const int a = find(t[0]), b = find(t[k]);
+      if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
     }
   }
   for (size_t v = 0; v < n; ++v) parent[v] = parent[static_cast<size_t>(parent[v])];  // each its root
@@ -630,6 +640,7 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
       out.voids += volume[v] < 0;
     }
   const long vertices = std::count(used.begin(), used.end(), 1);
+  counting.wait();
   out.euler = vertices - edge_count + static_cast<long>(mesh.triangles.size());
   return out;
 }
