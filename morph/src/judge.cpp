@@ -25,17 +25,24 @@ Verdict judge_triangle(const SkinComplex& complex, const std::array<Eigen::Vecto
   }
 }
 
+namespace {
+
+// Triangle t of `mesh` against the criteria, hinted by its first corner's cell.
+bool passes(const SkinComplex& complex, const SurfaceMesh& mesh, const std::array<int, 3>& t,
+            const MeshingOptions& criteria) {
+  return triangle_passes(complex,
+                         {mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
+                          mesh.vertices[static_cast<size_t>(t[2])]},
+                         mesh.cells[static_cast<size_t>(t[0])], criteria);
+}
+
+}  // namespace
+
 std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
                                     const std::vector<std::array<int, 3>>& triangles, const MeshingOptions& criteria) {
   std::vector<char> bad(triangles.size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
-      const std::array<int, 3>& t = triangles[i];
-      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
-                                                   mesh.vertices[static_cast<size_t>(t[1])],
-                                                   mesh.vertices[static_cast<size_t>(t[2])]};
-      bad[i] = !triangle_passes(complex, corners, mesh.cells[static_cast<size_t>(t[0])], criteria);
-    }
+    for (size_t i = r.begin(); i != r.end(); ++i) bad[i] = !passes(complex, mesh, triangles[i], criteria);
   });
   return bad;
 }
@@ -46,13 +53,8 @@ namespace {
 void judge_these(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<size_t>& at,
                  const MeshingOptions& criteria, std::vector<char>& failing) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, at.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k != r.end(); ++k) {
-      const std::array<int, 3>& t = mesh.triangles[at[k]];
-      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
-                                                   mesh.vertices[static_cast<size_t>(t[1])],
-                                                   mesh.vertices[static_cast<size_t>(t[2])]};
-      failing[at[k]] = !triangle_passes(complex, corners, mesh.cells[static_cast<size_t>(t[0])], criteria);
-    }
+    for (size_t k = r.begin(); k != r.end(); ++k)
+      failing[at[k]] = !passes(complex, mesh, mesh.triangles[at[k]], criteria);
   });
 }
 
@@ -108,10 +110,11 @@ void judge_known(const SkinComplex& complex, const SurfaceMesh& mesh, const Mesh
     for (size_t f = r.begin(); f != r.end(); ++f) {
       const std::array<int, 3>& t = mesh.triangles[f];
       kinds[f] = known_of(mesh, known, t);
-      if (kinds[f] == Known::carried)
-        j.failing[f] = !shape_passes({mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
-                                      mesh.vertices[static_cast<size_t>(t[2])]},
-                                     criteria.min_angle);
+      if (kinds[f] != Known::carried) continue;
+      const std::array<Eigen::Vector3d, 3> corners{mesh.vertices[static_cast<size_t>(t[0])],
+                                                   mesh.vertices[static_cast<size_t>(t[1])],
+                                                   mesh.vertices[static_cast<size_t>(t[2])]};
+      j.failing[f] = !shape_passes(corners, criteria.min_angle);
     }
   });
   std::vector<size_t> at;
