@@ -136,12 +136,15 @@ TEST_CASE("defects are counted: boundary, non-manifold edge, flipped triangle, i
   CHECK(qc.self_intersecting_pairs > 0);
 }
 
-TEST_CASE("self-intersections: the slabs find CGAL's pairs over the whole mesh", "[quality]") {
+TEST_CASE("self-intersections: the grid and CGAL's slabs find CGAL's pairs over the whole mesh", "[quality]") {
   // Tori through each other in every way: side by side across the cuts
   // between slabs (quantiles of the triangles' x), one tilted through the
   // other, and a copy shifted a little along x, whose triangles cross their
   // twins near every x, so that many crossing pairs straddle a cut. The
   // grader cuts two slabs from 180,000 triangles: two rings of 96,000.
+  // Triangles of one size take the grid; with one far larger triangle far
+  // away (it crosses nothing) the grid would be too large, and CGAL's
+  // slabs count.
   auto add = [](SurfaceMesh& to, const SurfaceMesh& from, const Eigen::Matrix3d& turn, const Eigen::Vector3d& shift) {
     const int base = static_cast<int>(to.vertices.size());
     for (const auto& v : from.vertices) to.vertices.push_back(turn * v + shift);
@@ -156,7 +159,16 @@ TEST_CASE("self-intersections: the slabs find CGAL's pairs over the whole mesh",
     const long expected = test::cgal_self_intersecting_pairs(both);
     CAPTURE(shift.transpose(), expected);
     REQUIRE(expected > 0);
-    CHECK(count_self_intersections(both) == expected);
+    const SelfIntersectionCount by_grid = check_self_intersections(both, std::numeric_limits<long>::max());
+    CHECK(by_grid.by_grid);
+    CHECK(by_grid.pairs == expected);
+    SurfaceMesh with_far = both;
+    const int base = static_cast<int>(with_far.vertices.size());
+    with_far.vertices.insert(with_far.vertices.end(), {Eigen::Vector3d(1000, 0, 0), Eigen::Vector3d(1500, 0, 0), Eigen::Vector3d(1000, 500, 0)});
+    with_far.triangles.push_back({base, base + 1, base + 2});
+    const SelfIntersectionCount by_slabs = check_self_intersections(with_far, std::numeric_limits<long>::max());
+    CHECK_FALSE(by_slabs.by_grid);
+    CHECK(by_slabs.pairs == expected);
   }
   CHECK(count_self_intersections(ring) == 0);
 }
@@ -259,6 +271,7 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   const long expected = test::cgal_self_intersecting_pairs(shaken);
   REQUIRE(expected > 0);
   const SelfIntersectionCount some = check_changed_self_intersections(shaken, moved, 1'000'000);
+  CHECK(some.by_grid);
   CHECK_FALSE(some.degenerate);
   CHECK_FALSE(some.over_bound);
   CHECK(some.pairs == expected);
@@ -297,6 +310,62 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   CHECK(CertifiedTriangles(ring, repeated).empty());
   CHECK(changed_count(certified.changed_in(CertifiedTriangles(ring, repeated))) == static_cast<long>(ring.triangles.size()));
   CHECK(changed_count(CertifiedTriangles().changed_in(CertifiedTriangles(ring, ids))) == static_cast<long>(ring.triangles.size()));
+}
+
+TEST_CASE("self-intersections: CGAL's box intersection where the grid does not suit (needles, a stack), CGAL's count",
+          "[quality]") {
+  // A certified torus with a shaken band, and 600 new needles (long thin
+  // triangles) through it and each other: each needle's box reaches
+  // hundreds of the grid's cells, too many entries for the grid, so CGAL's
+  // box intersection takes the changed triangles and the unchanged ones
+  // near them. Every crossing pair holds a changed triangle, so the count
+  // is CGAL's over every pair.
+  const SurfaceMesh ring = torus(200, 60, 3.0, 1.0);
+  std::vector<long> ids(ring.vertices.size());
+  for (size_t v = 0; v < ids.size(); ++v) ids[v] = static_cast<long>(v);
+  const CertifiedTriangles certified(ring, ids);
+  SurfaceMesh changed = ring;
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> shake(-0.05, 0.05), across(-4.0, 4.0), unit(-1.0, 1.0);
+  for (size_t v = 50 * 60; v < 60 * 60; ++v) changed.vertices[v] += Eigen::Vector3d(shake(random), shake(random), shake(random));
+  std::vector<long> changed_ids = ids;
+  for (int k = 0; k < 600; ++k) {
+    const Eigen::Vector3d p(across(random), across(random), 0.5 * unit(random));
+    const Eigen::Vector3d d = Eigen::Vector3d(unit(random), unit(random), 0.3 * unit(random)).normalized() * 6.0;
+    const Eigen::Vector3d side = d.unitOrthogonal() * 0.05;
+    const int base = static_cast<int>(changed.vertices.size());
+    changed.vertices.insert(changed.vertices.end(), {p, p + d, p + 0.5 * d + side});
+    changed.triangles.push_back({base, base + 1, base + 2});
+    for (int c = 0; c < 3; ++c) changed_ids.push_back(static_cast<long>(changed_ids.size()));
+  }
+  const std::vector<char> flags = certified.changed_in(CertifiedTriangles(changed, changed_ids));
+  const long expected = test::cgal_self_intersecting_pairs(changed);
+  REQUIRE(expected > 600);
+  const SelfIntersectionCount count = check_changed_self_intersections(changed, flags, std::numeric_limits<long>::max());
+  CHECK_FALSE(count.by_grid);
+  CHECK_FALSE(count.over_bound);
+  CHECK(count.pairs == expected);
+  // Without the needles the grid takes them, with the same count as CGAL.
+  SurfaceMesh band = changed;
+  band.vertices.resize(ring.vertices.size());
+  band.triangles.resize(ring.triangles.size());
+  const std::vector<char> band_flags = certified.changed_in(CertifiedTriangles(band, ids));
+  const SelfIntersectionCount band_count = check_changed_self_intersections(band, band_flags, std::numeric_limits<long>::max());
+  CHECK(band_count.by_grid);
+  CHECK(band_count.pairs == test::cgal_self_intersecting_pairs(band));
+  // 3,000 triangles stacked 1e-4 A apart, none meeting another: the grid's
+  // cells would hold them all and compare every pair, so CGAL counts.
+  SurfaceMesh stack;
+  for (int k = 0; k < 3000; ++k) {
+    const double z = 1e-4 * k;
+    const int base = static_cast<int>(stack.vertices.size());
+    stack.vertices.insert(stack.vertices.end(), {Eigen::Vector3d(0, 0, z), Eigen::Vector3d(1, 0, z), Eigen::Vector3d(0, 1, z)});
+    stack.triangles.push_back({base, base + 1, base + 2});
+  }
+  const SelfIntersectionCount stacked = check_self_intersections(stack, std::numeric_limits<long>::max());
+  CHECK_FALSE(stacked.by_grid);
+  CHECK(stacked.box_pairs == 0);
+  CHECK(stacked.pairs == 0);
 }
 
 TEST_CASE("every mesh reader reads the same mesh", "[quality][io]") {

@@ -71,14 +71,17 @@ struct GradeOptions {
 
 MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options = {});
 
-// Exact self-intersection check (CGAL's box intersection and exact
-// predicates): the triangle pairs that meet in more than the vertices and
-// edge they share by index. Memory grows with the mesh, not with the pairs.
+// Exact self-intersection check (CGAL's exact predicates on the pairs of
+// triangles whose bounding boxes meet, found by a uniform grid, or by
+// CGAL's box intersection where the boxes' sizes differ too much for a
+// grid): the triangle pairs that meet in more than the vertices and edge
+// they share by index. Memory grows with the mesh, not with the pairs.
 struct SelfIntersectionCount {
   long pairs = 0;           // crossing pairs (incomplete when over_bound)
-  long box_pairs = 0;       // pairs of overlapping boxes examined (a pair in two slabs twice)
+  long box_pairs = 0;       // pairs of overlapping boxes examined (by CGAL's slabs, a pair in two slabs twice)
   bool degenerate = false;  // a triangle with two equal indices or collinear corners: no answer
   bool over_bound = false;  // stopped after max_box_pairs box pairs: no answer
+  bool by_grid = false;     // the box pairs came from the grid, not from CGAL's box intersection
 };
 SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max_box_pairs);
 // The same over the pairs with a `changed` triangle (per triangle, 1 or
