@@ -6,8 +6,9 @@
 //   (c) the moving-balls engine: the first frame meshed, every later frame
 //       carried from the one before;
 //   (c_cmd) `skinmesh trajectory` over the same frames written as the models
-//       of a PDB file (a frame per model): the engine with the command's
-//       check of every frame and its output, as a user runs it.
+//       of an mmCIF file (a frame per model, coordinates in full): the
+//       engine with the command's check of every frame and its output, as a
+//       user runs it.
 // Motions: 2k39 model 1 -> 3 (fitted by Kabsch), a hinge motion of 3mht's
 // protein (residues 187-304 of chain A turned by 20 degrees), and 3mht's
 // DNA (chains C and D of its 3,141 atoms) moved 6 A off the protein and
@@ -60,7 +61,7 @@ constexpr double kShrink = 0.5;
 std::string data(const std::string& name) { return std::string(SKINMESH_DATA_DIR) + "/" + name; }
 
 // A motion: the balls at s in [0,1], and the atoms they are (in order),
-// from which the command's column writes the motion as a PDB file.
+// from which the command's column writes the motion as an mmCIF file.
 struct Motion {
   std::string name;
   size_t atoms = 0;
@@ -288,25 +289,38 @@ Column run_rebuilds(const Motion& motion, int frames, int sample) {
   return c;
 }
 
-// The motion's frames as the models of one PDB file (coordinates to the
-// 1e-3 A PDB keeps: an atom that does not move is written the same way in
-// every model).
+// The motion's frames as the models of one mmCIF file, each coordinate
+// with the 17 significant digits that give back its double, so that the
+// command's frames are c's (a PDB file's 1e-3 A would jitter every moving
+// atom and open and close small voids the engine then has to mend).
+std::string cif_text(const std::string& text) {
+  if (text.empty()) return "?";
+  if (text.find_first_of("'\" \t#$_[];") == std::string::npos) return text;
+  return text.find('"') == std::string::npos ? "\"" + text + "\"" : "'" + text + "'";
+}
+
 void write_models(const std::string& path, const Motion& motion, int frames) {
   std::FILE* out = std::fopen(path.c_str(), "w");
   if (!out) throw std::runtime_error("cannot write " + path);
+  std::fprintf(out, "data_bench_moving\nloop_\n");
+  for (const char* field : {"group_PDB", "id", "type_symbol", "label_atom_id", "label_alt_id", "label_comp_id",
+                            "label_asym_id", "label_seq_id", "pdbx_PDB_ins_code", "Cartn_x", "Cartn_y", "Cartn_z",
+                            "occupancy", "B_iso_or_equiv", "auth_seq_id", "auth_comp_id", "auth_asym_id",
+                            "auth_atom_id", "pdbx_PDB_model_num"})
+    std::fprintf(out, "_atom_site.%s\n", field);
+  long serial = 0;
   for (int k = 0; k < frames; ++k) {
     const std::vector<Ball> balls = motion.at(s_of(k, frames));
-    std::fprintf(out, "MODEL     %4d\n", k + 1);
     for (size_t i = 0; i < balls.size(); ++i) {
       const Atom& a = motion.atom_records[i];
-      const std::string name = a.name.size() < 4 && a.element.size() < 2 ? " " + a.name : a.name;
-      std::fprintf(out, "ATOM  %5zu %-4.4s %3.3s %1.1s%4d%c   %8.3f%8.3f%8.3f%6.2f%6.2f          %2.2s\n", (i + 1) % 100000,
-                   name.c_str(), a.residue.c_str(), a.chain.c_str(), a.residue_number, a.insertion_code,
-                   balls[i].center.x(), balls[i].center.y(), balls[i].center.z(), 1.0, 0.0, a.element.c_str());
+      const std::string name = cif_text(a.name), residue = cif_text(a.residue), chain = cif_text(a.chain);
+      const std::string code = a.insertion_code == ' ' ? "?" : std::string(1, a.insertion_code);
+      std::fprintf(out, "ATOM %ld %s %s . %s %s %d %s %.17g %.17g %.17g 1 0 %d %s %s %s %d\n", ++serial,
+                   cif_text(a.element).c_str(), name.c_str(), residue.c_str(), chain.c_str(), a.residue_number,
+                   code.c_str(), balls[i].center.x(), balls[i].center.y(), balls[i].center.z(), a.residue_number,
+                   residue.c_str(), chain.c_str(), name.c_str(), k + 1);
     }
-    std::fprintf(out, "ENDMDL\n");
   }
-  std::fprintf(out, "END\n");
   if (std::fclose(out) != 0) throw std::runtime_error("cannot write " + path);
 }
 
@@ -317,7 +331,7 @@ void write_models(const std::string& path, const Motion& motion, int frames) {
 Column run_command(const Motion& motion, int frames) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("bench_moving_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
-  const std::string models = (dir / "models.pdb").string(), out = (dir / "frames").string();
+  const std::string models = (dir / "models.cif").string(), out = (dir / "frames").string();
   write_models(models, motion, frames);
   const std::string command = std::string("'") + SKINMESH_BINARY + "' --quiet trajectory '" + models + "' -o '" + out +
                               "' --frames-per-step 1 --align none --format ply";
