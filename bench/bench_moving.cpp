@@ -289,16 +289,18 @@ Column run_rebuilds(const Motion& motion, int frames, int sample) {
   return c;
 }
 
-// The motion's frames as the models of one mmCIF file, each coordinate
-// with the 17 significant digits that give back its double, so that the
-// command's frames are c's (a PDB file's 1e-3 A would jitter every moving
-// atom and open and close small voids the engine then has to mend).
+// A value as mmCIF writes it: ? when empty, quoted when it holds a blank,
+// a quote or a character CIF reserves (O5' of a nucleotide).
 std::string cif_text(const std::string& text) {
   if (text.empty()) return "?";
   if (text.find_first_of("'\" \t#$_[];") == std::string::npos) return text;
   return text.find('"') == std::string::npos ? "\"" + text + "\"" : "'" + text + "'";
 }
 
+// The motion's frames as the models of one mmCIF file, each coordinate
+// with the 17 significant digits that give back its double, so that the
+// command's frames are c's (a PDB file's 1e-3 A would jitter every moving
+// atom and open and close small voids the engine then has to mend).
 void write_models(const std::string& path, const Motion& motion, int frames) {
   std::FILE* out = std::fopen(path.c_str(), "w");
   if (!out) throw std::runtime_error("cannot write " + path);
