@@ -177,6 +177,62 @@ long count_slab(const SurfaceMesh& mesh, std::vector<const Box*>& slab, size_t k
   });
 }
 
+// A uniform grid over boxes: cells twice as wide as the median box, so
+// that a box of a quality mesh reaches a few, spanning the boxes' reach.
+struct GridFrame {
+  Eigen::Array3d lo;
+  double cell = 1;
+  Eigen::Array3i size;
+
+  // Over the boxes `each` visits (each(f) with f(const Box&)); false when
+  // there are none, a coordinate is not finite, or the grid would have
+  // more than `cells_per_box` cells a box (and 4096).
+  template <class Each>
+  bool fit(Each each, double cells_per_box) {
+    std::vector<double> extent;
+    Eigen::AlignedBox3d reach;
+    each([&](const Box& b) {
+      double e = 0;
+      for (int k = 0; k < 3; ++k) e = std::max(e, b.max_coord(k) - b.min_coord(k));
+      extent.push_back(e);
+      reach.extend(Eigen::Vector3d(b.min_coord(0), b.min_coord(1), b.min_coord(2)));
+      reach.extend(Eigen::Vector3d(b.max_coord(0), b.max_coord(1), b.max_coord(2)));
+    });
+    if (extent.empty() || !reach.sizes().allFinite()) return false;
+    std::nth_element(extent.begin(), extent.begin() + static_cast<long>(extent.size() / 2), extent.end());
+    cell = std::max(2 * extent[extent.size() / 2], 1e-9 * (1 + reach.sizes().maxCoeff()));
+    lo = reach.min().array();
+    const Eigen::Array3d cells = ((reach.max().array() - lo) / cell).floor() + 1;
+    if (!(cells.prod() <= cells_per_box * static_cast<double>(extent.size()) + 4096)) return false;
+    size = cells.cast<int>();
+    return true;
+  }
+  size_t cells() const { return static_cast<size_t>(size.prod()); }
+  // The cell coordinate of x along axis k, clamped to the grid (order kept).
+  int coordinate(double x, int k) const {
+    return std::clamp(static_cast<int>(std::floor((x - lo[k]) / cell)), 0, size[k] - 1);
+  }
+  size_t index(int i, int j, int k) const {
+    return (static_cast<size_t>(i) * static_cast<size_t>(size[1]) + static_cast<size_t>(j)) * static_cast<size_t>(size[2]) +
+           static_cast<size_t>(k);
+  }
+  // on_cell(c) for the cells box b meets (clamped to the grid) until it
+  // returns true; whether one did. A box wholly outside meets none.
+  template <class OnCell>
+  bool visit(const Box& b, OnCell on_cell) const {
+    for (int k = 0; k < 3; ++k)
+      if (std::floor((b.max_coord(k) - lo[k]) / cell) < 0 || std::floor((b.min_coord(k) - lo[k]) / cell) >= size[k])
+        return false;
+    int first[3], last[3];
+    for (int k = 0; k < 3; ++k) first[k] = coordinate(b.min_coord(k), k), last[k] = coordinate(b.max_coord(k), k);
+    for (int i = first[0]; i <= last[0]; ++i)
+      for (int j = first[1]; j <= last[1]; ++j)
+        for (int k = first[2]; k <= last[2]; ++k)
+          if (on_cell(index(i, j, k))) return true;
+    return false;
+  }
+};
+
 // The box pairs of a uniform grid's cells. Among the boxes the first
 // `wanted` are paired with every box, the rest only with those: the pairs
 // of two boxes from the rest are not looked at. A pair is counted in the
@@ -193,29 +249,12 @@ class BoxGrid {
  public:
   // False when the grid does not suit the boxes.
   bool build(const std::vector<const Box*>& boxes) {
-    if (boxes.empty()) return false;
-    std::vector<double> extent;
-    extent.reserve(boxes.size());
-    Eigen::AlignedBox3d reach;
-    for (const Box* b : boxes) {
-      double e = 0;
-      for (int k = 0; k < 3; ++k) e = std::max(e, b->max_coord(k) - b->min_coord(k));
-      extent.push_back(e);
-      reach.extend(Eigen::Vector3d(b->min_coord(0), b->min_coord(1), b->min_coord(2)));
-      reach.extend(Eigen::Vector3d(b->max_coord(0), b->max_coord(1), b->max_coord(2)));
-    }
-    if (!reach.sizes().allFinite()) return false;
-    std::nth_element(extent.begin(), extent.begin() + static_cast<long>(extent.size() / 2), extent.end());
-    cell_ = std::max(2 * extent[extent.size() / 2], 1e-9 * (1 + reach.sizes().maxCoeff()));
-    lo_ = reach.min().array();
-    const Eigen::Array3d cells = ((reach.max().array() - lo_) / cell_).floor() + 1;
+    if (!grid_.fit([&](auto take) { for (const Box* b : boxes) take(*b); }, 4)) return false;
     const double n = static_cast<double>(boxes.size());
-    if (!(cells.prod() <= 4 * n + 4096)) return false;
-    size_ = cells.cast<int>();
-    start_.assign(static_cast<size_t>(size_.prod()) + 1, 0);
+    start_.assign(grid_.cells() + 1, 0);
     size_t entries = 0;
     for (const Box* b : boxes) {
-      entries += for_cells(*b, [&](size_t c) { ++start_[c + 1]; });
+      grid_.visit(*b, [&](size_t c) { return ++entries, ++start_[c + 1], false; });
       if (static_cast<double>(entries) > 8 * n + 4096) return false;
     }
     // Boxes that crowd a cell without meeting (plates stacked closer than
@@ -230,7 +269,7 @@ class BoxGrid {
     std::vector<size_t> fill(start_.begin(), start_.end() - 1);
     for (size_t i = 0; i < boxes.size(); ++i) {
       const Item item = item_of(*boxes[i], static_cast<int>(i));
-      for_cells(*boxes[i], [&](size_t c) { items_[fill[c]++] = item; });
+      grid_.visit(*boxes[i], [&](size_t c) { return items_[fill[c]++] = item, false; });
     }
     return true;
   }
@@ -277,7 +316,7 @@ class BoxGrid {
   Item item_of(const Box& b, int box) const {
     Item item{};
     for (int k = 0; k < 3; ++k) {
-      item.first[k] = coordinate(b.min_coord(k), k);
+      item.first[k] = grid_.coordinate(b.min_coord(k), k);
       item.lo[k] = static_cast<float>(b.min_coord(k));
       if (item.lo[k] > b.min_coord(k)) item.lo[k] = std::nextafter(item.lo[k], -std::numeric_limits<float>::infinity());
       item.hi[k] = static_cast<float>(b.max_coord(k));
@@ -291,33 +330,14 @@ class BoxGrid {
              q.hi[2] < p.lo[2]);
   }
 
-  int coordinate(double x, int k) const {
-    return std::clamp(static_cast<int>(std::floor((x - lo_[k]) / cell_)), 0, size_[k] - 1);
-  }
-  size_t index(int i, int j, int k) const {
-    return (static_cast<size_t>(i) * static_cast<size_t>(size_[1]) + static_cast<size_t>(j)) * static_cast<size_t>(size_[2]) +
-           static_cast<size_t>(k);
-  }
   // The cell of the lowest corner of two meeting boxes' intersection: its
   // coordinates are the larger of the two boxes' first cells (coordinate()
   // keeps the order of the numbers it is given).
   size_t owner(const Item& p, const Item& q) const {
-    return index(std::max(p.first[0], q.first[0]), std::max(p.first[1], q.first[1]), std::max(p.first[2], q.first[2]));
+    return grid_.index(std::max(p.first[0], q.first[0]), std::max(p.first[1], q.first[1]),
+                       std::max(p.first[2], q.first[2]));
   }
-  template <class OnCell>
-  size_t for_cells(const Box& b, OnCell on_cell) const {
-    int first[3], last[3];
-    for (int k = 0; k < 3; ++k) first[k] = coordinate(b.min_coord(k), k), last[k] = coordinate(b.max_coord(k), k);
-    for (int i = first[0]; i <= last[0]; ++i)
-      for (int j = first[1]; j <= last[1]; ++j)
-        for (int k = first[2]; k <= last[2]; ++k) on_cell(index(i, j, k));
-    return static_cast<size_t>(last[0] - first[0] + 1) * static_cast<size_t>(last[1] - first[1] + 1) *
-           static_cast<size_t>(last[2] - first[2] + 1);
-  }
-
-  Eigen::Array3d lo_;
-  double cell_ = 1;
-  Eigen::Array3i size_;
+  GridFrame grid_;
   std::vector<size_t> start_;  // per cell, its first entry in items_ (one more at the end)
   std::vector<Item> items_;    // per cell, its boxes, ascending
 };
@@ -395,65 +415,30 @@ struct NearPairs {
 };
 
 NearPairs near_changed(const std::vector<Box>& boxes, const std::vector<char>& changed, bool changed_too) {
-  std::vector<double> extent;
-  Eigen::AlignedBox3d reach;
-  for (size_t f = 0; f < boxes.size(); ++f)
-    if (changed[f]) {
-      const Box& b = boxes[f];
-      double e = 0;
-      for (int k = 0; k < 3; ++k) e = std::max(e, b.max_coord(k) - b.min_coord(k));
-      extent.push_back(e);
-      reach.extend(Eigen::Vector3d(b.min_coord(0), b.min_coord(1), b.min_coord(2)));
-      reach.extend(Eigen::Vector3d(b.max_coord(0), b.max_coord(1), b.max_coord(2)));
-    }
   NearPairs out;
-  const auto every_box = [&] {
+  if (std::find(changed.begin(), changed.end(), 1) == changed.end()) return out;
+  GridFrame grid;
+  const auto each_changed = [&](auto take) {
+    for (size_t f = 0; f < boxes.size(); ++f)
+      if (changed[f]) take(boxes[f]);
+  };
+  if (!grid.fit(each_changed, 16)) {
     for (size_t f = 0; f < boxes.size(); ++f)
       if (!changed[f] || changed_too) (changed[f] ? out.changed : out.unchanged).push_back(&boxes[f]);
     return out;
-  };
-  if (extent.empty()) return out;
-  std::nth_element(extent.begin(), extent.begin() + static_cast<long>(extent.size() / 2), extent.end());
-  const double cell = std::max(2 * extent[extent.size() / 2], 1e-9 * (1 + reach.sizes().maxCoeff()));
-  const Eigen::Array3d lo = reach.min().array();
-  const Eigen::Array3d cells = ((reach.max().array() - lo) / cell).floor() + 1;
-  const double most = 16.0 * static_cast<double>(extent.size()) + 4096;
-  if (!(cells.prod() <= most)) return every_box();
-  const Eigen::Array3i size = cells.cast<int>();
+  }
   // Per cell: 1 when a changed box reaches it, 2 when a kept unchanged one does too.
-  std::vector<char> mark(static_cast<size_t>(size.prod()), 0);
-  // The cells a box meets, clamped to the grid; false when it lies outside.
-  const auto range = [&](const Box& b, Eigen::Array3i& first, Eigen::Array3i& last) {
-    for (int k = 0; k < 3; ++k) {
-      const double a = std::floor((b.min_coord(k) - lo[k]) / cell), z = std::floor((b.max_coord(k) - lo[k]) / cell);
-      if (z < 0 || a >= size[k]) return false;
-      first[k] = static_cast<int>(std::max(a, 0.0));
-      last[k] = static_cast<int>(std::min(z, static_cast<double>(size[k] - 1)));
-    }
-    return true;
-  };
-  const auto visit = [&](const Box& b, auto on_cell) {
-    Eigen::Array3i first, last;
-    if (!range(b, first, last)) return false;
-    for (int i = first[0]; i <= last[0]; ++i)
-      for (int j = first[1]; j <= last[1]; ++j)
-        for (int k = first[2]; k <= last[2]; ++k)
-          if (on_cell((static_cast<size_t>(i) * static_cast<size_t>(size[1]) + static_cast<size_t>(j)) *
-                          static_cast<size_t>(size[2]) +
-                      static_cast<size_t>(k)))
-            return true;
-    return false;
-  };
+  std::vector<char> mark(grid.cells(), 0);
   for (size_t f = 0; f < boxes.size(); ++f)
-    if (changed[f]) visit(boxes[f], [&](size_t c) { return mark[c] = 1, false; });
+    if (changed[f]) grid.visit(boxes[f], [&](size_t c) { return mark[c] = 1, false; });
   for (size_t f = 0; f < boxes.size(); ++f)
-    if (!changed[f] && visit(boxes[f], [&](size_t c) { return mark[c] != 0; })) {
+    if (!changed[f] && grid.visit(boxes[f], [&](size_t c) { return mark[c] != 0; })) {
       out.unchanged.push_back(&boxes[f]);
-      if (changed_too) visit(boxes[f], [&](size_t c) { return mark[c] = mark[c] ? 2 : 0, false; });
+      if (changed_too) grid.visit(boxes[f], [&](size_t c) { return mark[c] = mark[c] ? 2 : 0, false; });
     }
   if (changed_too)
     for (size_t f = 0; f < boxes.size(); ++f)
-      if (changed[f] && visit(boxes[f], [&](size_t c) { return mark[c] == 2; })) out.changed.push_back(&boxes[f]);
+      if (changed[f] && grid.visit(boxes[f], [&](size_t c) { return mark[c] == 2; })) out.changed.push_back(&boxes[f]);
   return out;
 }
 
