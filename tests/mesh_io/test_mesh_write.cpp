@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <iterator>
 #include <sstream>
@@ -26,6 +27,27 @@ SurfaceMesh octahedron() {
   m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   for (const auto& v : m.vertices) m.normals.push_back(v.normalized());
   m.cells = {0, 1, 2, 3, 4, 5};
+  return m;
+}
+
+// A torus of n x n quads, each cut in two: a mesh whose files are many
+// times the writers' 64 KiB chunks.
+SurfaceMesh torus(int n) {
+  SurfaceMesh m;
+  const double pi = 3.14159265358979323846;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double u = 2 * pi * i / n, v = 2 * pi * j / n;
+      m.vertices.emplace_back((3 + std::cos(v)) * std::cos(u), (3 + std::cos(v)) * std::sin(u), std::sin(v));
+      m.normals.emplace_back(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v));
+      m.cells.push_back(i);
+    }
+  const auto at = [n](int i, int j) { return (i % n) * n + j % n; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
   return m;
 }
 
@@ -163,4 +185,51 @@ TEST_CASE("text formats write every real as printf's %.17g (or %.9g) would", "[i
       }
     }
   }
+}
+
+// The writers gather their output and hand it to the stream in chunks: a
+// mesh whose files hold many chunks reads back value for value, and the
+// VTP's points are the vertices, in order.
+TEST_CASE("meshes many times the writers' chunks read back exactly", "[io]") {
+  const SurfaceMesh m = torus(120);  // 14,400 vertices, 28,800 triangles
+  VertexAttributes attributes;
+  for (size_t v = 0; v < m.vertices.size(); ++v) {
+    attributes.patch.push_back(static_cast<int>(v % 4));
+    attributes.atom.push_back(static_cast<int>(v % 1000));
+  }
+  for (const bool ascii : {false, true})
+    for (const char* name : {"big.ply", "big.off", "big.obj", "big.stl"}) {
+      INFO(name << (ascii ? " as text" : ""));
+      TempFile file(name);
+      MeshWriteOptions options;
+      options.ascii = ascii;
+      {
+        std::ofstream out(file.path(), std::ios::binary);
+        write_mesh(out, m, mesh_format_from_path(name), &attributes, options);
+      }
+      const SurfaceMesh back = read_surface_mesh(file.path());
+      REQUIRE(back.triangles.size() == m.triangles.size());
+      if (std::string(name) == "big.stl") {  // corners merged where equal, as floats
+        CHECK(back.vertices.size() == m.vertices.size());
+        continue;
+      }
+      REQUIRE(back.vertices.size() == m.vertices.size());
+      CHECK(back.triangles == m.triangles);
+      long differ = 0;
+      for (size_t v = 0; v < m.vertices.size(); ++v) differ += back.vertices[v] != m.vertices[v];
+      CHECK(differ == 0);
+    }
+  std::ostringstream out;
+  write_mesh(out, m, MeshFormat::vtp, &attributes);
+  const std::string text = out.str();
+  const std::string opening = "NumberOfComponents=\"3\" format=\"ascii\">\n";
+  const size_t first = text.find(opening);
+  REQUIRE(first != std::string::npos);
+  std::istringstream points(text.substr(first + opening.size(), text.find("</DataArray>", first) - first - opening.size()));
+  long differ = 0, read = 0;
+  for (Eigen::Vector3d p; points >> p[0] >> p[1] >> p[2]; ++read)
+    differ += static_cast<size_t>(read) >= m.vertices.size() || p != m.vertices[static_cast<size_t>(read)];
+  CHECK(read == static_cast<long>(m.vertices.size()));
+  CHECK(differ == 0);
+  CHECK(text.size() > 16 * 65536);
 }

@@ -10,11 +10,70 @@
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 namespace skinmesh {
 namespace {
 
 int digits(const MeshWriteOptions& o) { return o.single_precision ? 9 : 17; }
+
+// What a writer makes, gathered and handed to the stream 64 KiB at a
+// time: a stream call per value took most of the time of writing a frame.
+class Sink {
+ public:
+  explicit Sink(std::ostream& out) : out_(out), bytes_(kChunk) {}
+  Sink(const Sink&) = delete;
+  Sink& operator=(const Sink&) = delete;
+  ~Sink() { flush(); }
+  // A value's bytes (little endian on every machine we build for: checked by write_ply).
+  template <class T>
+  void put(T value) {
+    if (used_ + sizeof(T) > kChunk) flush();
+    std::memcpy(bytes_.data() + used_, &value, sizeof(T));
+    used_ += sizeof(T);
+  }
+  void text(const char* begin, size_t size) {
+    if (used_ + size > kChunk) flush();
+    if (size > kChunk) {
+      out_.write(begin, static_cast<std::streamsize>(size));
+      return;
+    }
+    std::memcpy(bytes_.data() + used_, begin, size);
+    used_ += size;
+  }
+  void flush() {
+    if (used_ > 0) out_.write(bytes_.data(), static_cast<std::streamsize>(used_));
+    used_ = 0;
+  }
+
+ private:
+  static constexpr size_t kChunk = size_t{1} << 16;
+  std::ostream& out_;
+  std::vector<char> bytes_;
+  size_t used_ = 0;
+};
+
+Sink& operator<<(Sink& out, const char* text) {
+  out.text(text, std::strlen(text));
+  return out;
+}
+Sink& operator<<(Sink& out, const std::string& text) {
+  out.text(text.data(), text.size());
+  return out;
+}
+Sink& operator<<(Sink& out, char c) {
+  out.text(&c, 1);
+  return out;
+}
+template <class T, std::enable_if_t<std::is_integral_v<T>, int> = 0>
+Sink& operator<<(Sink& out, T value) {
+  char text[24];
+  const auto end = std::to_chars(text, text + sizeof(text), value).ptr;
+  out.text(text, static_cast<size_t>(end - text));
+  return out;
+}
 
 // A real as `out << std::setprecision(digits) << value` writes it (printf's
 // %.*g), formatted by std::to_chars: the stream's own formatting was most
@@ -23,28 +82,25 @@ struct Real {
   double value;
   int digits;
 };
-std::ostream& operator<<(std::ostream& out, Real r) {
+Sink& operator<<(Sink& out, Real r) {
   char text[64];
   const auto end = std::to_chars(text, text + sizeof(text), r.value, std::chars_format::general, r.digits).ptr;
-  return out.write(text, end - text);
+  out.text(text, static_cast<size_t>(end - text));
+  return out;
 }
 // A point or normal as its three Reals, one space apart.
 struct Reals3 {
   const Eigen::Vector3d& value;
   int digits;
 };
-std::ostream& operator<<(std::ostream& out, Reals3 r) {
+Sink& operator<<(Sink& out, Reals3 r) {
   return out << Real{r.value[0], r.digits} << ' ' << Real{r.value[1], r.digits} << ' ' << Real{r.value[2], r.digits};
 }
 // An integer as `out << value` writes it.
 struct Integer {
   long long value;
 };
-std::ostream& operator<<(std::ostream& out, Integer i) {
-  char text[24];
-  const auto end = std::to_chars(text, text + sizeof(text), i.value).ptr;
-  return out.write(text, end - text);
-}
+Sink& operator<<(Sink& out, Integer i) { return out << i.value; }
 
 Eigen::Vector3d normal_of(const SurfaceMesh& mesh, size_t v) {
   return v < mesh.normals.size() ? mesh.normals[v] : Eigen::Vector3d::Zero();
@@ -76,12 +132,6 @@ const char* vtk_type(PropertyType t) {
   return t == PropertyType::uint8 ? "UInt8" : t == PropertyType::uint32 ? "UInt32" : "Int32";
 }
 
-template <class T>
-void put(std::ostream& out, T value) {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &value, sizeof(T));  // little endian on every machine we build for (checked below)
-  out.write(bytes, sizeof(T));
-}
 
 void write_ply_header(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
                       const MeshWriteOptions& options) {
@@ -128,22 +178,22 @@ void write_ply_body(const SurfaceMesh& mesh, const VertexAttributes* attributes,
 }
 
 struct BinaryPly {
-  std::ostream& out;
+  Sink& out;
   bool single;
   void real(double v) {
-    if (single) put(out, static_cast<float>(v));
-    else put(out, v);
+    if (single) out.put(static_cast<float>(v));
+    else out.put(v);
   }
   void integer(PropertyType type, int v) {
-    if (type == PropertyType::uint8) put(out, static_cast<uint8_t>(v));
-    else if (type == PropertyType::uint32) put(out, static_cast<uint32_t>(v));
-    else put(out, static_cast<int32_t>(v));
+    if (type == PropertyType::uint8) out.put(static_cast<uint8_t>(v));
+    else if (type == PropertyType::uint32) out.put(static_cast<uint32_t>(v));
+    else out.put(static_cast<int32_t>(v));
   }
   void end_line() {}
 };
 
 struct TextPly {
-  std::ostream& out;
+  Sink& out;
   int digits;
   bool first = true;
   void separate() {
@@ -171,22 +221,28 @@ void write_ply(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
   if (*reinterpret_cast<const uint8_t*>(&probe) != 1) contract_error("the PLY writer needs a little-endian host");
   write_ply_header(out, mesh, attributes, options);
   if (options.ascii) {
-    TextPly text{out, digits(options)};
+    Sink sink(out);
+    TextPly text{sink, digits(options)};
     write_ply_body(mesh, attributes, text);
+    sink.flush();
   } else {
-    BinaryPly binary{out, options.single_precision};
+    Sink sink(out);
+    BinaryPly binary{sink, options.single_precision};
     write_ply_body(mesh, attributes, binary);
+    sink.flush();
   }
 }
 
-void write_off(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+void write_off(std::ostream& stream, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+  Sink out(stream);
   const int d = digits(options);
   out << "OFF\n" << mesh.vertices.size() << " " << mesh.triangles.size() << " 0\n";
   for (const auto& v : mesh.vertices) out << Reals3{v, d} << "\n";
   for (const auto& t : mesh.triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
 }
 
-void write_obj(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+void write_obj(std::ostream& stream, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+  Sink out(stream);
   const bool normals = mesh.normals.size() == mesh.vertices.size();
   const int d = digits(options);
   out << "# skinmesh: molecular skin surface\n";
@@ -209,22 +265,25 @@ void write_stl(std::ostream& out, const SurfaceMesh& mesh) {
   char header[80] = {};
   std::strncpy(header, "skinmesh: molecular skin surface (binary STL, single precision)", sizeof(header) - 1);
   out.write(header, sizeof(header));
-  put(out, static_cast<uint32_t>(mesh.triangles.size()));
+  Sink sink(out);
+  sink.put(static_cast<uint32_t>(mesh.triangles.size()));
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
     const Eigen::Vector3d& b = mesh.vertices[static_cast<size_t>(t[1])];
     const Eigen::Vector3d& c = mesh.vertices[static_cast<size_t>(t[2])];
     const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
-    for (int k = 0; k < 3; ++k) put(out, static_cast<float>(n[k]));
+    for (int k = 0; k < 3; ++k) sink.put(static_cast<float>(n[k]));
     for (const Eigen::Vector3d* p : {&a, &b, &c})
-      for (int k = 0; k < 3; ++k) put(out, static_cast<float>((*p)[k]));
-    put(out, static_cast<uint16_t>(0));
+      for (int k = 0; k < 3; ++k) sink.put(static_cast<float>((*p)[k]));
+    sink.put(static_cast<uint16_t>(0));
   }
+  sink.flush();
 }
 
 // VTK XML PolyData, ASCII: opens in ParaView with normals and attributes.
-void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
+void write_vtp(std::ostream& stream, const SurfaceMesh& mesh, const VertexAttributes* attributes,
                const MeshWriteOptions& options) {
+  Sink out(stream);
   const char* real = options.single_precision ? "Float32" : "Float64";
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       << "<PolyData>\n<Piece NumberOfPoints=\"" << mesh.vertices.size() << "\" NumberOfPolys=\""
@@ -260,7 +319,8 @@ void write_vtp(std::ostream& out, const SurfaceMesh& mesh, const VertexAttribute
 }  // namespace
 
 // Gmsh MSH 4.1 ASCII: one surface entity, physical group 1 named "skin".
-void write_gmsh_surface(std::ostream& out, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+void write_gmsh_surface(std::ostream& stream, const SurfaceMesh& mesh, const MeshWriteOptions& options) {
+  Sink out(stream);
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
   for (const auto& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
   if (mesh.vertices.empty()) lo = hi = Eigen::Vector3d::Zero();
@@ -330,8 +390,9 @@ namespace {
 int msms_face_type(int patch) { return patch <= 0 ? 1 : patch == 1 ? 2 : 3; }
 }  // namespace
 
-void write_msms_vert(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
+void write_msms_vert(std::ostream& stream, const SurfaceMesh& mesh, const VertexAttributes* attributes,
                      const MeshWriteOptions& options) {
+  Sink out(stream);
   const bool attrs = has(attributes, mesh);
   out << "# MSMS-format vertices written by skinmesh (molecular skin surface)\n"
       << "#vertex #sphere density probe_r\n"
@@ -345,12 +406,14 @@ void write_msms_vert(std::ostream& out, const SurfaceMesh& mesh, const VertexAtt
     out << Reals3{p, d} << " " << Reals3{n, d} << " 0 "
         << (attrs ? attributes->atom[v] + 1 : 0) << " " << msms_face_type(attrs ? attributes->patch[v] : 0) << "\n";
   }
-  if (!out) output_error("", "writing the MSMS vertices failed");
+  out.flush();
+  if (!stream) output_error("", "writing the MSMS vertices failed");
 }
 
 // As MSMS writes them: three 1-based corners, the face type (of the
 // triangle's first corner), the analytic face (0: none numbered).
-void write_msms_face(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes) {
+void write_msms_face(std::ostream& stream, const SurfaceMesh& mesh, const VertexAttributes* attributes) {
+  Sink out(stream);
   const bool attrs = has(attributes, mesh);
   out << "# MSMS-format triangles written by skinmesh (molecular skin surface)\n"
       << "#faces #sphere density probe_r\n"
@@ -358,7 +421,8 @@ void write_msms_face(std::ostream& out, const SurfaceMesh& mesh, const VertexAtt
   for (const auto& t : mesh.triangles)
     out << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << " "
         << msms_face_type(attrs ? attributes->patch[static_cast<size_t>(t[0])] : 0) << " 0\n";
-  if (!out) output_error("", "writing the MSMS triangles failed");
+  out.flush();
+  if (!stream) output_error("", "writing the MSMS triangles failed");
 }
 
 }  // namespace skinmesh
