@@ -197,9 +197,13 @@ const std::vector<char>* FrameCrossings::changed(const SurfaceMesh& mesh, const 
   return &changed_;
 }
 
-void FrameCrossings::checked(bool held) {
+void FrameCrossings::checked(const SurfaceMesh& mesh, const SkinReference& skin, GuaranteeReport& report) {
+  answers_ = OracleAnswers{};
+  if (!skin.oracle && report.distances.size() == mesh.vertices.size())
+    answers_ = OracleAnswers{skin.balls, skin.shrink, mesh.vertices, std::move(report.distances)};
+  report.distances.clear();
   if (options_.skip || options_.pairs != "changed") return;
-  certified_ = held ? std::move(now_) : CertifiedTriangles();
+  certified_ = report.all_hold() ? std::move(now_) : CertifiedTriangles();
   now_ = CertifiedTriangles();
 }
 
@@ -210,12 +214,14 @@ FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, co
   o.on_skin_tolerance = kFrameOnSkinTolerance;
   o.self_intersections = crossings.skipped() ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
   o.changed_triangles = crossings.changed(mesh, ids);
+  o.earlier = crossings.earlier_answers();
+  o.report_distances = !skin.oracle;
   FrameCheck c;
   c.guarantees = check_guarantees(mesh, skin, o);
   // The grade's smallest angle clearly above the bound (its formula may
   // differ from share_below's in the last bits): no triangle is below.
   c.share_below_bound = c.guarantees.quality.min_angle > min_angle + 1e-9 ? 0.0 : share_below(mesh, min_angle);
-  crossings.checked(c.holds());
+  crossings.checked(mesh, skin, c.guarantees);
   return c;
 }
 
@@ -243,6 +249,7 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"remeshed_because", s.remeshed ? json(s.remeshed_because) : json(nullptr)},
           {"max_onsurf_error", c.guarantees.surface_error.max},
           {"oracle_uncertified", c.guarantees.surface_error.uncertified},
+          {"oracle_answers_kept", c.guarantees.distances_kept},
           {"components", q.components},
           {"voids", q.cavities},
           {"euler", q.euler},

@@ -116,20 +116,27 @@ struct FrameCrossingOptions {
   bool skip = false;
   std::string pairs = "changed";
 };
-// The test's state through a run of frames, checked one after the other.
+// The check's state through a run of frames, checked one after the other:
+// the triangles the self-intersection test certified, and the static
+// oracle's answers (OracleAnswers: a frame of moving atoms asks the oracle
+// again only where a ball near a vertex moved, or the vertex did).
 class FrameCrossings {
  public:
   explicit FrameCrossings(FrameCrossingOptions o = {}) : options_(std::move(o)) {}
   bool skipped() const { return options_.skip; }
   // Per triangle of `mesh` (ids per vertex), the triangles to test: null for all.
   const std::vector<char>* changed(const SurfaceMesh& mesh, const std::vector<long>& ids);
-  // After the frame's check: its triangles certified when every guarantee held.
-  void checked(bool held);
+  // The answers of the frame before (null: none).
+  const OracleAnswers* earlier_answers() const { return answers_.points.empty() ? nullptr : &answers_; }
+  // After the frame's check: its triangles certified when every guarantee
+  // held; its oracle answers kept when the static oracle gave them.
+  void checked(const SurfaceMesh& mesh, const SkinReference& skin, GuaranteeReport& report);
 
  private:
   FrameCrossingOptions options_;
   CertifiedTriangles certified_, now_;
   std::vector<char> changed_;
+  OracleAnswers answers_;
 };
 
 // The frame (ids per vertex) checked against `skin`: every guarantee, the

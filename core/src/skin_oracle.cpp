@@ -399,7 +399,9 @@ OracleResult SkinOracle::solve_from(const Eigen::Vector3d& x, std::vector<int> c
         violators.push_back(k);
       violation = std::max(violation, gap);
     };
-    visit_near(*grid_, balls_, x, certification_radius(shrink_, st.r, st.mu, grid_->max_weight()), check);
+    const double reach = certification_radius(shrink_, st.r, st.mu, grid_->max_weight());
+    visit_near(*grid_, balls_, x, reach, check);
+    out.reach = std::isfinite(reach) ? reach : INFINITY;
     out.kkt_violation = violation;
     out.certified = violation < 1e-9;
     if (violators.empty()) break;

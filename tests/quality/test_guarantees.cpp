@@ -105,3 +105,69 @@ TEST_CASE("check_guarantees: two interpenetrating tetrahedra intersect", "[quali
   CHECK(g.no_self_intersections == std::optional<bool>(false));
   CHECK_FALSE(g.on_skin);
 }
+
+// An earlier frame's oracle answers stand where no ball near the vertex
+// changed (GuaranteeOptions::earlier); everywhere the check keeps one, the
+// oracle asked afresh gives the same distance, and where the balls moved
+// the distance is the new one, not the kept one.
+TEST_CASE("check_guarantees: earlier oracle answers are kept only where no near ball changed", "[quality][guarantees]") {
+  const auto balls = balls_from_molecule(read_molecule(test::data_file("pept.pdb")), 0.5);
+  const SkinMeshResult r = mesh_skin(build_skin_complex(balls, {0.5}));
+  REQUIRE(r.status == MeshingStatus::ok);
+  GuaranteeOptions report;
+  report.report_distances = true;
+  CHECK(check_guarantees(r.mesh, balls, 0.5).distances.empty());
+  const GuaranteeReport first = check_guarantees(r.mesh, balls, 0.5, report);
+  REQUIRE(first.distances.size() == r.mesh.vertices.size());
+  const OracleAnswers earlier{balls, 0.5, r.mesh.vertices, first.distances};
+  GuaranteeOptions keep = report;
+  keep.earlier = &earlier;
+  // The atoms on one side of the middle moved 0.3 A along x.
+  std::vector<double> xs;
+  for (const Ball& b : balls) xs.push_back(b.center.x());
+  std::nth_element(xs.begin(), xs.begin() + static_cast<long>(xs.size() / 2), xs.end());
+  const double middle = xs[xs.size() / 2];
+  std::vector<Ball> moved = balls;
+  for (Ball& b : moved)
+    if (b.center.x() > middle) b.center.x() += 0.3;
+  const auto same_as_asked_afresh = [&](const SurfaceMesh& mesh, const std::vector<Ball>& now) {
+    const GuaranteeReport kept = check_guarantees(mesh, now, 0.5, keep);
+    const GuaranteeReport fresh = check_guarantees(mesh, now, 0.5, report);
+    REQUIRE(kept.distances.size() == fresh.distances.size());
+    double worst = 0;
+    for (size_t v = 0; v < kept.distances.size(); ++v)
+      worst = std::max(worst, std::abs(kept.distances[v].distance - fresh.distances[v].distance));
+    CHECK(worst <= 1e-12);
+    CHECK(kept.surface_error.max == Approx(fresh.surface_error.max).margin(1e-12));
+    CHECK(kept.on_skin == fresh.on_skin);
+    return kept;
+  };
+  SECTION("the same balls: every answer stands") {
+    const GuaranteeReport g = same_as_asked_afresh(r.mesh, balls);
+    CHECK(g.distances_kept == static_cast<long>(r.mesh.vertices.size()));
+  }
+  SECTION("half the atoms moved: the far half's answers stand, the mesh is off the moved skin") {
+    const GuaranteeReport g = same_as_asked_afresh(r.mesh, moved);
+    CHECK(g.distances_kept > 0);
+    CHECK(g.distances_kept < static_cast<long>(r.mesh.vertices.size()) / 2 + 1);
+    CHECK(g.surface_error.max > 0.1);
+    CHECK_FALSE(g.on_skin);
+  }
+  SECTION("a vertex moved: its answer is asked again") {
+    SurfaceMesh shifted = r.mesh;
+    shifted.vertices[0] += 0.01 * shifted.normals[0];
+    const GuaranteeReport g = same_as_asked_afresh(shifted, balls);
+    CHECK(g.distances_kept == static_cast<long>(r.mesh.vertices.size()) - 1);
+    CHECK(g.surface_error.max == Approx(0.01).epsilon(0.05));
+  }
+  SECTION("a ball made heavier, or one more ball: nothing stands") {
+    std::vector<Ball> heavier = balls;
+    heavier[0].weight = 1.5 * std::max_element(balls.begin(), balls.end(), [](const Ball& a, const Ball& b) {
+                                return a.weight < b.weight;
+                              })->weight;
+    CHECK(same_as_asked_afresh(r.mesh, heavier).distances_kept == 0);
+    std::vector<Ball> more = balls;
+    more.push_back(Ball{balls[0].center + Eigen::Vector3d(100, 0, 0), 4.0});
+    CHECK(same_as_asked_afresh(r.mesh, more).distances_kept == 0);
+  }
+}

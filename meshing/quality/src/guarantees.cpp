@@ -1,9 +1,13 @@
 #include "skinmesh/quality/guarantees.hpp"
 
 #include "skinmesh/core/skin_complex.hpp"
+#include "skinmesh/core/point_grid.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,15 +16,73 @@
 namespace skinmesh {
 namespace {
 
-// Each vertex's distance by the oracle; a vertex it cannot certify is
-// measured on the complex of the skin's balls built from scratch (the
-// skin function, |F| / |grad F|), which no mesher's state enters either.
-SurfaceError distances(const std::vector<Eigen::Vector3d>& vertices, const SkinReference& skin) {
+// Per vertex, the earlier answer that stands for `skin`'s balls
+// (OracleAnswers), or -1: one at the same point whose reach holds no ball
+// that changed, its old centre or its new one.
+std::vector<long> standing_answers(const std::vector<Eigen::Vector3d>& vertices, const SkinReference& skin,
+                                   const OracleAnswers& earlier) {
+  std::vector<long> out(vertices.size(), -1);
+  const std::vector<Ball>& now = skin.balls;
+  if (earlier.balls.size() != now.size() || earlier.shrink != skin.shrink || now.empty() ||
+      earlier.points.size() != earlier.distances.size())
+    return out;
+  const auto heaviest = [](const std::vector<Ball>& balls) {
+    return std::max_element(balls.begin(), balls.end(), [](const Ball& a, const Ball& b) { return a.weight < b.weight; })
+        ->weight;
+  };
+  if (heaviest(now) > heaviest(earlier.balls)) return out;
+  constexpr double kCell = 4.0;  // Angstrom: about an answer's reach
+  PointGrid<Eigen::Vector3d> changed(kCell);
+  for (size_t i = 0; i < now.size(); ++i)
+    if (now[i].center != earlier.balls[i].center || now[i].weight != earlier.balls[i].weight) {
+      changed.insert(now[i].center, now[i].center);
+      changed.insert(earlier.balls[i].center, earlier.balls[i].center);
+    }
+  // The earlier points in lexicographic order, for finding a vertex's own.
+  std::vector<long> order(earlier.points.size());
+  std::iota(order.begin(), order.end(), 0L);
+  const auto before = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  };
+  tbb::parallel_sort(order.begin(), order.end(), [&](long a, long b) {
+    return before(earlier.points[static_cast<size_t>(a)], earlier.points[static_cast<size_t>(b)]);
+  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const Eigen::Vector3d& x = vertices[v];
+      const auto it = std::lower_bound(order.begin(), order.end(), x, [&](long e, const Eigen::Vector3d& p) {
+        return before(earlier.points[static_cast<size_t>(e)], p);
+      });
+      if (it == order.end() || earlier.points[static_cast<size_t>(*it)] != x) continue;
+      const SkinDistance& d = earlier.distances[static_cast<size_t>(*it)];
+      if (!d.certified || !std::isfinite(d.reach)) continue;
+      const int span = static_cast<int>(std::ceil(d.reach / kCell));
+      const bool near = changed.any_near(x, span, [&](const Eigen::Vector3d& c) { return (c - x).norm() <= d.reach; });
+      if (!near) out[v] = *it;
+    }
+  });
+  return out;
+}
+
+// Each vertex's distance by the oracle (or kept from `earlier`, with the
+// static oracle); a vertex it cannot certify is measured on the complex of
+// the skin's balls built from scratch (the skin function, |F| / |grad F|),
+// which no mesher's state enters either.
+SurfaceError distances(const std::vector<Eigen::Vector3d>& vertices, const SkinReference& skin,
+                       const OracleAnswers* earlier, std::vector<SkinDistance>& d, long& kept) {
   std::optional<SkinOracle> own_oracle;
   if (!skin.oracle) own_oracle.emplace(skin.balls, skin.shrink);
-  const std::vector<SkinDistance> d =
-      oracle_distances(vertices, skin.oracle ? skin.oracle : point_oracle(*own_oracle),
-                       skin.starts.size() == vertices.size() ? skin.starts : std::vector<OracleStart>{});
+  const PointOracle oracle = skin.oracle ? skin.oracle : point_oracle(*own_oracle);
+  const bool with_starts = skin.starts.size() == vertices.size();
+  const std::vector<long> standing =
+      earlier && !skin.oracle ? standing_answers(vertices, skin, *earlier) : std::vector<long>(vertices.size(), -1);
+  d.assign(vertices.size(), SkinDistance{});
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      d[v] = standing[v] >= 0 ? earlier->distances[static_cast<size_t>(standing[v])]
+                              : oracle(vertices[v], with_starts ? skin.starts[v] : kNoStart);
+  });
+  kept = std::count_if(standing.begin(), standing.end(), [](long e) { return e >= 0; });
   std::vector<double> off(d.size());
   SurfaceError e;
   for (size_t v = 0; v < d.size(); ++v) {
@@ -53,10 +115,11 @@ GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const SkinReference& s
   // oracle's distances (parallel over the vertices) and the skin's alpha
   // complex: together they keep both cores busy.
   tbb::parallel_invoke([&] { r.quality = grade_mesh(mesh, grade); },
-                       [&] { r.surface_error = distances(mesh.vertices, skin); },
+                       [&] { r.surface_error = distances(mesh.vertices, skin, options.earlier, r.distances, r.distances_kept); },
                        [&] {
                          if (options.topology) r.skin = skin.topology ? *skin.topology : skin_topology(skin.balls);
                        });
+  if (!options.report_distances) std::vector<SkinDistance>().swap(r.distances);
   const MeshQuality& q = r.quality;
   // The bound is met to rounding: angles are computed from the written
   // doubles, and a triangle refined to exactly 30 degrees reads 30 - 1e-14.

@@ -15,7 +15,7 @@ namespace skinmesh {
 PointOracle point_oracle(const SkinOracle& oracle) {
   return [&oracle](const Eigen::Vector3d& x, const OracleStart& start) {
     const OracleResult o = oracle.evaluate(x, start);
-    return SkinDistance{o.distance(), o.certified};
+    return SkinDistance{o.distance(), o.certified, o.reach};
   };
 }
 

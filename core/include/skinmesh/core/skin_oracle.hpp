@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cmath>
 
 #include <memory>
 #include <utility>
@@ -28,6 +29,12 @@ struct OracleResult {
   std::vector<std::pair<int, double>> support;          // (ball, l_i > 0)
   double kkt_violation = 0.0;  // worst optimality violation over all balls, relative; ~1e-15 when certified
   bool certified = false;      // kkt_violation below 1e-9
+  // Every ball whose centre lies farther than this from x (Angstrom) meets
+  // the optimality conditions by a bound that holds for any ball of weight
+  // at most the largest weight of the balls; the answer stands, unchanged,
+  // for another ball set that agrees with this one within `reach` of x and
+  // has no larger weight (the check of morph frames relies on this).
+  double reach = INFINITY;
 
   // First-order distance to the skin |F| / |grad F| (Angstrom).
   double distance() const;

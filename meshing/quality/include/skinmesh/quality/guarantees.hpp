@@ -41,6 +41,19 @@ struct SkinReference {
   std::optional<SkinTopology> topology;
 };
 
+// The static oracle's answers at a checked mesh's vertices, for the check
+// of a later mesh of nearly the same balls (a frame of moving atoms): an
+// answer at the same point stands, not asked again, when no ball within
+// its reach changed (by index, centre and weight), the balls are as many,
+// none weighs more than the heaviest did, and the shrink is the same
+// (OracleResult::reach).
+struct OracleAnswers {
+  std::vector<Ball> balls;
+  double shrink = 0;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<SkinDistance> distances;  // per point
+};
+
 struct GuaranteeOptions {
   double min_angle = 30.0;           // degrees: the bound every triangle's smallest angle must meet
   double on_skin_tolerance = 1e-9;   // Angstrom: largest distance of a vertex from the skin
@@ -48,6 +61,10 @@ struct GuaranteeOptions {
   // Per triangle, changed since a certified frame (GradeOptions::changed); null: every pair tested.
   const std::vector<char>* changed_triangles = nullptr;
   bool topology = true;              // components, voids and Euler characteristic those of the skin
+  // With the static oracle (SkinReference::oracle empty): earlier answers
+  // that stand for these balls are kept (OracleAnswers); null: every vertex asked.
+  const OracleAnswers* earlier = nullptr;
+  bool report_distances = false;     // GuaranteeReport::distances filled (for the next frame's `earlier`)
 };
 
 struct GuaranteeReport {
@@ -55,6 +72,8 @@ struct GuaranteeReport {
   // Distances of the vertices: by the oracle, and where it could not
   // certify (counted in `uncertified`), on the balls' complex built from scratch.
   SurfaceError surface_error;
+  std::vector<SkinDistance> distances;         // per vertex, by the oracle, with GuaranteeOptions::report_distances
+  long distances_kept = 0;                     // vertices whose answer came from GuaranteeOptions::earlier
   std::optional<SkinTopology> skin;            // the skin's topology, when checked
   bool angle = false;                          // some triangle, and every smallest angle >= the bound
   bool on_skin = false;                        // every vertex within the tolerance

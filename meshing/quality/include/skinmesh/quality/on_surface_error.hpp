@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cmath>
 #include <functional>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct SurfaceError {
 struct SkinDistance {
   double distance = 0;
   bool certified = false;
+  // The static oracle's OracleResult::reach (Angstrom): the answer stands
+  // for any balls that agree within it of the point and weigh no more.
+  double reach = INFINITY;
 };
 // Where an oracle's solve starts at a point: up to four of the skin's balls
 // (indices, -1 for none; a mesher's vertex: the balls of its mixed cell).
