@@ -27,8 +27,8 @@ std::vector<long> standing_answers(const std::vector<Eigen::Vector3d>& vertices,
       earlier.points.size() != earlier.distances.size())
     return out;
   const auto heaviest = [](const std::vector<Ball>& balls) {
-    return std::max_element(balls.begin(), balls.end(), [](const Ball& a, const Ball& b) { return a.weight < b.weight; })
-        ->weight;
+    const auto lighter = [](const Ball& a, const Ball& b) { return a.weight < b.weight; };
+    return std::max_element(balls.begin(), balls.end(), lighter)->weight;
   };
   if (heaviest(now) > heaviest(earlier.balls)) return out;
   constexpr double kCell = 4.0;  // Angstrom: about an answer's reach
@@ -115,7 +115,9 @@ GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const SkinReference& s
   // oracle's distances (parallel over the vertices) and the skin's alpha
   // complex: together they keep both cores busy.
   tbb::parallel_invoke([&] { r.quality = grade_mesh(mesh, grade); },
-                       [&] { r.surface_error = distances(mesh.vertices, skin, options.earlier, r.distances, r.distances_kept); },
+                       [&] {
+                         r.surface_error = distances(mesh.vertices, skin, options.earlier, r.distances, r.distances_kept);
+                       },
                        [&] {
                          if (options.topology) r.skin = skin.topology ? *skin.topology : skin_topology(skin.balls);
                        });

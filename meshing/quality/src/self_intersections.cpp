@@ -51,28 +51,33 @@ bool triangles_cross(const SurfaceMesh& mesh, const std::array<int, 3>& a, const
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       if (a[i] == b[j]) ++shared, ia = i, ib = j;
-  const auto p = [&](const std::array<int, 3>& t, int i) { return point(mesh, t[static_cast<size_t>(i % 3)]); };
   if (shared == 3) return true;
+  const std::array<K::Point_3, 3> pa{point(mesh, a[0]), point(mesh, a[1]), point(mesh, a[2])};
+  const std::array<K::Point_3, 3> pb{point(mesh, b[0]), point(mesh, b[1]), point(mesh, b[2])};
+  const auto at = [](const std::array<K::Point_3, 3>& t, int i) -> const K::Point_3& {
+    return t[static_cast<size_t>(i % 3)];
+  };
   if (shared == 2) {
     // The corner of a not in b, and of b not in a; u, v the shared corners.
     int far_a = 0, far_b = 0;
     while (std::find(b.begin(), b.end(), a[static_cast<size_t>(far_a)]) != b.end()) ++far_a;
     while (std::find(a.begin(), a.end(), b[static_cast<size_t>(far_b)]) != a.end()) ++far_b;
-    const K::Point_3 u = p(a, far_a + 1), v = p(a, far_a + 2), pa = p(a, far_a), pb = p(b, far_b);
-    return CGAL::coplanar(u, v, pa, pb) && CGAL::coplanar_orientation(u, v, pa, pb) == CGAL::POSITIVE;
+    const K::Point_3 &u = at(pa, far_a + 1), &v = at(pa, far_a + 2), &p = at(pa, far_a), &q = at(pb, far_b);
+    return CGAL::coplanar(u, v, p, q) && CGAL::coplanar_orientation(u, v, p, q) == CGAL::POSITIVE;
   }
-  const K::Triangle_3 ta(p(a, 0), p(a, 1), p(a, 2)), tb(p(b, 0), p(b, 1), p(b, 2));
-  if (shared == 0) return CGAL::do_intersect(ta, tb);
-  const K::Segment_3 opposite_a(p(a, ia + 1), p(a, ia + 2)), opposite_b(p(b, ib + 1), p(b, ib + 2));
-  // A triangle whose opposite edge lies strictly on one side of the other's
-  // plane touches that plane only at w: the usual case on a smooth surface,
-  // decided by two orientations instead of two triangle-segment tests.
-  const auto off_plane = [](const K::Triangle_3& t, const K::Segment_3& s) {
-    const CGAL::Orientation o = CGAL::orientation(t[0], t[1], t[2], s.source());
-    return o != CGAL::COPLANAR && o == CGAL::orientation(t[0], t[1], t[2], s.target());
+  if (shared == 0) return CGAL::do_intersect(K::Triangle_3(pa[0], pa[1], pa[2]), K::Triangle_3(pb[0], pb[1], pb[2]));
+  // A triangle whose edge opposite the shared corner lies strictly on one
+  // side of the other's plane touches that plane only at the shared
+  // corner: the usual case on a smooth surface, decided by two orientations
+  // instead of two triangle-segment tests.
+  const auto off_plane = [](const std::array<K::Point_3, 3>& t, const K::Point_3& s, const K::Point_3& e) {
+    const CGAL::Orientation o = CGAL::orientation(t[0], t[1], t[2], s);
+    return o != CGAL::COPLANAR && o == CGAL::orientation(t[0], t[1], t[2], e);
   };
-  if (off_plane(tb, opposite_a) || off_plane(ta, opposite_b)) return false;
-  return CGAL::do_intersect(ta, opposite_b) || CGAL::do_intersect(tb, opposite_a);
+  if (off_plane(pb, at(pa, ia + 1), at(pa, ia + 2)) || off_plane(pa, at(pb, ib + 1), at(pb, ib + 2))) return false;
+  const K::Triangle_3 ta(pa[0], pa[1], pa[2]), tb(pb[0], pb[1], pb[2]);
+  return CGAL::do_intersect(ta, K::Segment_3(at(pb, ib + 1), at(pb, ib + 2))) ||
+         CGAL::do_intersect(tb, K::Segment_3(at(pa, ia + 1), at(pa, ia + 2)));
 }
 
 Box box_of(const SurfaceMesh& mesh, int f) {
