@@ -209,7 +209,7 @@ struct FrameReference {
 // reference.pairs; empty: its own start). The topology from B(t)'s balls.
 FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleStart>& starts,
                              const std::vector<long>& ids, const FrameReference& reference, double t,
-                             double min_angle, FrameCrossings& crossings) {
+                             double min_angle, FrameCheckHistory& history) {
   SkinReference skin;
   skin.balls = reference.balls_at(t);
   skin.shrink = reference.shrink;
@@ -221,7 +221,7 @@ FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleSt
     const MorphOracleResult e = reference.oracle.evaluate(x, t, pairs);
     return SkinDistance{e.distance(), e.certified};
   };
-  return check_frame(mesh, ids, skin, min_angle, crossings);
+  return check_frame(mesh, ids, skin, min_angle, history);
 }
 
 // The m x n morph's frames.jsonl line: the common fields and its events.
@@ -489,7 +489,7 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
   PaceEstimate pace(times.size());
   BlendFrame pending;
   FrameCheck check;
-  FrameCrossings crossings(crossing_options);
+  FrameCheckHistory history(crossing_options);
   tbb::task_group checking;  // after what its task reads: if advance_to throws, it waits before they go
   const auto finish = [&]() {
     checking.wait();
@@ -514,7 +514,7 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
     pending = std::move(made);
     checking.run([&] {  // the check, then the frame's files, beside the next frame
       check = check_blend_frame(pending.frame.mesh, pending.starts, pending.frame.ids, reference, pending.t, min_angle,
-                                crossings);
+                                history);
       if (check.holds()) stage_frame(out.outputs, out.dir, pending, out.files);
     });
   }

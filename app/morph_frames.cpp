@@ -189,7 +189,7 @@ double share_below(const SurfaceMesh& mesh, double bound_degrees) {
   return mesh.triangles.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(mesh.triangles.size());
 }
 
-const std::vector<char>* FrameCrossings::changed(const SurfaceMesh& mesh, const std::vector<long>& ids) {
+const std::vector<char>* FrameCheckHistory::changed(const SurfaceMesh& mesh, const std::vector<long>& ids) {
   if (options_.skip || options_.pairs != "changed") return nullptr;
   now_ = CertifiedTriangles(mesh, ids);
   if (certified_.empty()) return nullptr;
@@ -197,7 +197,7 @@ const std::vector<char>* FrameCrossings::changed(const SurfaceMesh& mesh, const 
   return &changed_;
 }
 
-void FrameCrossings::checked(const SurfaceMesh& mesh, const SkinReference& skin, GuaranteeReport& report) {
+void FrameCheckHistory::checked(const SurfaceMesh& mesh, const SkinReference& skin, GuaranteeReport& report) {
   answers_ = OracleAnswers{};
   if (!skin.oracle && report.distances.size() == mesh.vertices.size())
     answers_ = OracleAnswers{skin.balls, skin.shrink, mesh.vertices, std::move(report.distances)};
@@ -208,20 +208,20 @@ void FrameCrossings::checked(const SurfaceMesh& mesh, const SkinReference& skin,
 }
 
 FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, const SkinReference& skin,
-                       double min_angle, FrameCrossings& crossings) {
+                       double min_angle, FrameCheckHistory& history) {
   GuaranteeOptions o;
   o.min_angle = min_angle;
   o.on_skin_tolerance = kFrameOnSkinTolerance;
-  o.self_intersections = crossings.skipped() ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
-  o.changed_triangles = crossings.changed(mesh, ids);
-  o.earlier = crossings.earlier_answers();
+  o.self_intersections = history.skipped() ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
+  o.changed_triangles = history.changed(mesh, ids);
+  o.earlier = history.earlier_answers();
   o.report_distances = !skin.oracle;
   FrameCheck c;
   c.guarantees = check_guarantees(mesh, skin, o);
   // The grade's smallest angle clearly above the bound (its formula may
   // differ from share_below's in the last bits): no triangle is below.
   c.share_below_bound = c.guarantees.quality.min_angle > min_angle + 1e-9 ? 0.0 : share_below(mesh, min_angle);
-  crossings.checked(mesh, skin, c.guarantees);
+  history.checked(mesh, skin, c.guarantees);
   return c;
 }
 
@@ -302,9 +302,9 @@ MadeFrame snapshot(const MovingBalls& moving, size_t k) {
   return m;
 }
 
-FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, FrameCrossings& crossings) {
+FrameCheck check_moving_frame(const MadeFrame& made, double min_angle, FrameCheckHistory& history) {
   return check_frame(made.frame.mesh, made.frame.ids,
-                     SkinReference{made.balls, made.shrink, {}, made.starts, made.topology}, min_angle, crossings);
+                     SkinReference{made.balls, made.shrink, {}, made.starts, made.topology}, min_angle, history);
 }
 
 json moving_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
@@ -353,7 +353,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
   MovingBalls moving(run.balls_of(0), options, run.times.front());
   MadeFrame pending;
   FrameCheck check;
-  FrameCrossings crossings(run.crossings);
+  FrameCheckHistory history(run.crossings);
   tbb::task_group checking;
   // Waits for the pending frame's check and files, then records its line; false when it failed.
   const auto finish = [&]() {
@@ -382,7 +382,7 @@ MovingFramesResult run_moving_frames(const MovingFrames& run, FrameFiles& files,
     if (k > 0 && !finish()) return result;
     pending = std::move(made);
     checking.run([&] {
-      check = check_moving_frame(pending, run.options.frames.min_angle, crossings);
+      check = check_moving_frame(pending, run.options.frames.min_angle, history);
       if (check.holds()) stage_moving_frame(outputs, dir, pending, run, files);
     });
   }

@@ -120,9 +120,9 @@ struct FrameCrossingOptions {
 // the triangles the self-intersection test certified, and the static
 // oracle's answers (OracleAnswers: a frame of moving atoms asks the oracle
 // again only where a ball near a vertex moved, or the vertex did).
-class FrameCrossings {
+class FrameCheckHistory {
  public:
-  explicit FrameCrossings(FrameCrossingOptions o = {}) : options_(std::move(o)) {}
+  explicit FrameCheckHistory(FrameCrossingOptions o = {}) : options_(std::move(o)) {}
   bool skipped() const { return options_.skip; }
   // Per triangle of `mesh` (ids per vertex), the triangles to test: null for all.
   const std::vector<char>* changed(const SurfaceMesh& mesh, const std::vector<long>& ids);
@@ -140,9 +140,9 @@ class FrameCrossings {
 };
 
 // The frame (ids per vertex) checked against `skin`: every guarantee, the
-// topology included; `crossings` then holds this frame as the one before.
+// topology included; `history` then holds this frame as the one before.
 FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, const SkinReference& skin,
-                       double min_angle, FrameCrossings& crossings);
+                       double min_angle, FrameCheckHistory& history);
 // The frames.jsonl fields both kinds of morph write.
 nlohmann::json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file);
 
