@@ -15,6 +15,7 @@
 #include "judge.hpp"
 #include "local_repair.hpp"
 #include "surgery.hpp"
+#include "vanishing.hpp"
 
 #include <Eigen/Geometry>
 
@@ -369,5 +370,128 @@ TEST_CASE("local repair: a patch that fails is tried once more from the start wi
     REQUIRE_FALSE(narrow.ok);
     REQUIRE(narrow.failed_because.find("nearly the whole frame") != std::string::npos);
     CHECK(patched_with(f, &PatchPolicy::wider_rings, 1).attempts == narrow.attempts);
+  }
+}
+
+namespace {
+
+// A closed mesh appended to `mesh`: an octahedron (a sphere, Euler 2) of
+// half-diagonal r at c. Returns the index of its first vertex.
+int add_octahedron(SurfaceMesh& mesh, const Eigen::Vector3d& c, double r) {
+  const int o = static_cast<int>(mesh.vertices.size());
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                   Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, -1)}) {
+    mesh.vertices.push_back(c + r * d);
+    mesh.normals.push_back(d);
+    mesh.cells.push_back(0);
+  }
+  for (const std::array<int, 3>& t : std::vector<std::array<int, 3>>{
+           {0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}})
+    mesh.triangles.push_back({o + t[0], o + t[1], o + t[2]});
+  return o;
+}
+
+// A torus (Euler 0) of n x n quads, radii R and r, about the z axis through c.
+void add_torus(SurfaceMesh& mesh, const Eigen::Vector3d& c, double R, double r, int n) {
+  const int o = static_cast<int>(mesh.vertices.size());
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double u = 2 * M_PI * i / n, v = 2 * M_PI * j / n;
+      mesh.vertices.push_back(c + Eigen::Vector3d((R + r * std::cos(v)) * std::cos(u),
+                                                  (R + r * std::cos(v)) * std::sin(u), r * std::sin(v)));
+      mesh.normals.push_back(Eigen::Vector3d::UnitZ());
+      mesh.cells.push_back(0);
+    }
+  const auto at = [&](int i, int j) { return o + (i % n) * n + (j % n); };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+}
+
+std::vector<int> marked(const std::vector<char>& marks) {
+  std::vector<int> out;
+  for (size_t v = 0; v < marks.size(); ++v)
+    if (marks[v]) out.push_back(static_cast<int>(v));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("a vanishing sphere takes the one sphere component wholly within its reach, and nothing else",
+          "[morph][events]") {
+  // A large sphere, two small ones 3 A apart, a torus, and an unused vertex
+  // inside the first small sphere (no triangle uses it).
+  SurfaceMesh mesh;
+  add_octahedron(mesh, Eigen::Vector3d::Zero(), 10);
+  const int small = add_octahedron(mesh, Eigen::Vector3d(20, 0, 0), 1);
+  add_octahedron(mesh, Eigen::Vector3d(23, 0, 0), 1);
+  add_torus(mesh, Eigen::Vector3d(0, 20, 0), 2, 0.5, 12);
+  mesh.vertices.push_back(Eigen::Vector3d(20, 0, 0));
+  mesh.normals.push_back(Eigen::Vector3d::UnitZ());
+  mesh.cells.push_back(0);
+  const std::vector<char> none(mesh.vertices.size(), 0);
+  std::vector<int> first_small;
+  for (int v = small; v < small + 6; ++v) first_small.push_back(v);
+  std::vector<char> found;
+  using detail::VanishingSphere;
+
+  SECTION("the small sphere alone within reach is taken, every vertex of it and no other") {
+    const std::vector<char> drop = detail::vanishing_components(mesh, none, {{Eigen::Vector3d(20, 0, 0), 1.5}}, found);
+    CHECK(found == std::vector<char>{1});
+    CHECK(marked(drop) == first_small);
+  }
+  SECTION("two sphere components within reach: neither is taken") {
+    const std::vector<char> drop = detail::vanishing_components(mesh, none, {{Eigen::Vector3d(21.5, 0, 0), 3}}, found);
+    CHECK(found == std::vector<char>{0});
+    CHECK(marked(drop).empty());
+  }
+  SECTION("a component a vertex of which stayed in its cell is not taken") {
+    std::vector<char> stayed = none;
+    stayed[static_cast<size_t>(small + 3)] = 1;
+    const std::vector<char> drop =
+        detail::vanishing_components(mesh, stayed, {{Eigen::Vector3d(20, 0, 0), 1.5}}, found);
+    CHECK(found == std::vector<char>{0});
+    CHECK(marked(drop).empty());
+  }
+  SECTION("a component only partly within reach is not taken, however closed its part within reach looks") {
+    // A second octahedron sharing the small one's vertex (21, 0, 0): within
+    // 1.05 A of (20, 0, 0) lie the small one's 8 triangles, closed as a
+    // sphere, while the component goes on beyond.
+    SurfaceMesh pinched = mesh;
+    const int shared = small;  // (21, 0, 0)
+    const int second = add_octahedron(pinched, Eigen::Vector3d(22, 0, 0), 1);
+    for (auto& t : pinched.triangles)
+      for (int& v : t)
+        if (v == second + 1) v = shared;  // (21, 0, 0) is the second's -x corner
+    const std::vector<char> stayed(pinched.vertices.size(), 0);
+    const std::vector<char> drop =
+        detail::vanishing_components(pinched, stayed, {{Eigen::Vector3d(20, 0, 0), 1.05}}, found);
+    CHECK(found == std::vector<char>{0});
+    CHECK(marked(drop).empty());
+    // Within a reach that holds the whole large sphere, and nothing else, it is taken.
+    const std::vector<char> large = detail::vanishing_components(mesh, none, {{Eigen::Vector3d::Zero(), 10.5}}, found);
+    CHECK(found == std::vector<char>{1});
+    CHECK(marked(large) == std::vector<int>{0, 1, 2, 3, 4, 5});
+  }
+  SECTION("a component that is not a sphere is not taken") {
+    const std::vector<char> drop = detail::vanishing_components(mesh, none, {{Eigen::Vector3d(0, 20, 0), 3}}, found);
+    CHECK(found == std::vector<char>{0});
+    CHECK(marked(drop).empty());
+  }
+  SECTION("a component is taken by one sphere only") {
+    const std::vector<char> drop = detail::vanishing_components(
+        mesh, none, {{Eigen::Vector3d(20, 0, 0), 1.5}, {Eigen::Vector3d(20.2, 0, 0), 1.5}}, found);
+    CHECK(found == std::vector<char>{1, 0});
+    CHECK(marked(drop) == first_small);
+  }
+  SECTION("each sphere takes its own") {
+    const std::vector<char> drop = detail::vanishing_components(
+        mesh, none, {{Eigen::Vector3d(23, 0, 0), 1.5}, {Eigen::Vector3d(20, 0, 0), 1.5}}, found);
+    CHECK(found == std::vector<char>{1, 1});
+    std::vector<int> both = first_small;
+    for (int v = small + 6; v < small + 12; ++v) both.push_back(v);
+    CHECK(marked(drop) == both);
   }
 }
