@@ -90,17 +90,17 @@ std::vector<Eigen::Matrix3d> neighbourhood_rotations(const SkinComplex& from, co
   return rotations;
 }
 
-// The rotation a cell's patch turns by (docs/math.md section 6): its first
-// ball's neighbourhood rotation, corrected by the least rotation that puts
-// the direction space of delta_X exactly onto its new place (the edge's
-// direction, the triangle's plane), so that the quadric maps onto the new
-// one exactly. A vertex's and a tetrahedron's quadric is isotropic in its
-// direction space: any rotation maps it.
+// The rotation a cell's patch turns by (docs/math.md section 6): `r` (its
+// first ball's neighbourhood rotation, or the rigid motion that carried all
+// its balls), corrected by the least rotation that puts the direction space
+// of delta_X exactly onto its new place (the edge's direction, the
+// triangle's plane), so that the quadric maps onto the new one exactly. A
+// vertex's and a tetrahedron's quadric is isotropic in its direction space:
+// any rotation maps it.
 Eigen::Matrix3d cell_rotation(const MixedCell& cell, const std::vector<Ball>& old, const std::vector<Ball>& now,
-                              const std::vector<Eigen::Matrix3d>& rotations) {
+                              const Eigen::Matrix3d& r) {
   const auto at = [](const std::vector<Ball>& balls, int i) { return balls[static_cast<size_t>(i)].center; };
   const std::array<int, 4>& x = cell.balls;
-  Eigen::Matrix3d r = rotations[static_cast<size_t>(x[0])];
   Eigen::Vector3d before, after;
   if (cell.dim == 1) {
     before = (at(old, x[1]) - at(old, x[0])).normalized();
@@ -334,6 +334,7 @@ struct CellMap {
   int persisting = -1;
   bool quiet = false;
   bool mapped = false;
+  bool still = false;  // mapped, and none of its balls moved: its vertices stay where they are
   Eigen::Vector3d from_center = Eigen::Vector3d::Zero(), to_center = Eigen::Vector3d::Zero();
   Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
   double scale = 1;
@@ -349,7 +350,8 @@ struct CellMaps {
 };
 
 CellMaps cell_maps(const SkinComplex& from, const SkinComplex& to, const std::vector<Eigen::Matrix3d>& rotations,
-                   const std::vector<char>& quiet, const std::vector<int>& cells) {
+                   const std::vector<char>& quiet, const std::optional<detail::RigidMotion>& motion,
+                   const std::vector<int>& cells) {
   CellMaps out;
   out.slot.assign(from.cells().size(), -1);
   std::vector<int> used;  // the cells with a vertex, ascending
@@ -375,8 +377,25 @@ CellMaps cell_maps(const SkinComplex& from, const SkinComplex& to, const std::ve
       if (!m.mapped) continue;
       m.from_center = c0.center;
       m.to_center = c1.center;
-      m.turn = cell_rotation(c0, from.balls(), to.balls(), rotations);
       m.scale = std::sqrt(ratio);
+      // A cell whose balls all stayed keeps its patch: its vertices stay put
+      // rather than turn with their neighbourhood, so that the judge can find
+      // their triangles settled (skin_unchanged_near). One whose balls the
+      // step's largest rigid motion carried turns with that motion, so that
+      // its vertices move by it and their triangles can be carried.
+      const auto all_balls = [&](auto&& test) {
+        for (int i = 0; i <= c0.dim; ++i)
+          if (!test(static_cast<size_t>(c0.balls[static_cast<size_t>(i)]))) return false;
+        return true;
+      };
+      m.still = all_balls([&](size_t b) {
+        return from.balls()[b].center == to.balls()[b].center && from.balls()[b].weight == to.balls()[b].weight;
+      });
+      if (m.still) continue;
+      const bool carried =
+          motion && all_balls([&](size_t b) { return motion->carries(from.balls()[b], to.balls()[b]); });
+      const Eigen::Matrix3d& start = carried ? motion->rotation : rotations[static_cast<size_t>(c0.balls[0])];
+      m.turn = cell_rotation(c0, from.balls(), to.balls(), start);
     }
   });
   return out;
@@ -392,7 +411,8 @@ VertexFate move_vertex(const SkinComplex& from, const SkinComplex& to, const Cel
     return VertexFate::kept;
   }
   if (map.mapped) {
-    const Eigen::Vector3d q = map.to_center + map.scale * (map.turn * (p - map.from_center));
+    const Eigen::Vector3d q =
+        map.still ? p : Eigen::Vector3d(map.to_center + map.scale * (map.turn * (p - map.from_center)));
     constexpr double kOnBoundary = 1e-9;  // Angstrom-scaled membership slack (rounding on a cell face)
     if (to.membership_violation(map.persisting, q) <= kOnBoundary) {
       p = q;
@@ -886,7 +906,14 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   const std::vector<std::array<int, 3>> triangles_before = moved.triangles;  // as they were: the repair changes them
   const size_t n = moved.vertices.size();
   std::vector<VertexFate> fates(n);
-  const CellMaps maps = cell_maps(complex_, next, rotations, quiet, moved.cells);
+  // Balls whose neighbourhood moved as one rigid body. The largest such
+  // motion turns the cells it carried whole (cell_maps); thinning decides as
+  // it did where the cells around a vertex moved so: the same edge lengths,
+  // targets and fans.
+  const std::vector<char> rigid_balls = rigidly_moved_balls(complex_, next.balls(), rotations);
+  const std::optional<detail::RigidMotion> largest =
+      largest_rigid_motion(complex_.balls(), next.balls(), rigid_balls, rotations);
+  const CellMaps maps = cell_maps(complex_, next, rotations, quiet, largest, moved.cells);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       fates[v] = move_vertex(complex_, next, maps.of(moved.cells[v]), moved.vertices[v], moved.cells[v]);
@@ -901,9 +928,6 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // it as before, so it keeps the verdict it had: it passed, when the step
   // before ended with every triangle judged passing.
   const std::vector<char> settled_balls = with_all_neighbours(complex_, next, quiet);
-  // Thinning would decide as it did where the cells around a vertex moved
-  // as one rigid body: the same edge lengths, targets and fans.
-  const std::vector<char> rigid_balls = rigidly_moved_balls(complex_, next.balls(), rotations);
   // The judge's counterpart: a triangle whose corners moved with cells two
   // rings of rigid motion deep sees a congruent skin (judge.hpp).
   const std::vector<char> carried_balls = with_all_neighbours(complex_, next, rigid_balls);
@@ -921,8 +945,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // A vertex the step's largest rigid motion carried, not carried by its
   // rings, whose skin within the judge's reach that motion carried as well
   // (balls_moving_with) is carried though atoms nearby moved otherwise.
-  const std::optional<detail::RigidMotion> motion =
-      all_passed_ ? largest_rigid_motion(complex_.balls(), next.balls(), rigid_balls, rotations) : std::nullopt;
+  const std::optional<detail::RigidMotion> motion = all_passed_ ? largest : std::nullopt;
   const std::vector<char> unproven_carried =
       motion ? moved_by(*motion, next, frame_.mesh, moved, fates, carried_balls) : std::vector<char>(n, 0);
   const bool any_unproven = std::find(unproven.begin(), unproven.end(), 1) != unproven.end();

@@ -848,3 +848,48 @@ TEST_CASE("the topology certificate refuses a frame whose bookkeeping is wrong",
     CHECK_THROWS_WITH(moving.advance_to(balls, 1), Catch::Contains("the frame is refused"));
   }
 }
+
+TEST_CASE("moving balls: vertices stay where no ball of their cell moved, and turn with the hinge where it carried all",
+          "[moving]") {
+  // Ubiquitin's residues 70-76 turned by a degree about the CA atom before
+  // them, one step. Near the hinge, a cell of atoms that stayed has
+  // neighbours that moved: its vertices stay put rather than turn with that
+  // neighbourhood, and a cell of atoms the hinge carried turns with the
+  // hinge rather than with a neighbourhood that mixes both.
+  const UbiquitinTail tail = ubiquitin_tail(70);
+  const Eigen::Vector3d axis(0, 0, 1);
+  MovingBalls moving(tail.start, MovingOptions{});
+  const MorphFrame before = moving.frame();
+  std::unordered_map<long, Eigen::Vector3d> was;
+  for (size_t v = 0; v < before.ids.size(); ++v) was[before.ids[v]] = before.mesh.vertices[v];
+  const std::vector<Ball> after = hinged(tail.start, tail.moving, tail.pivot, axis, 1.0);
+  const MorphFrame& f = moving.advance_to(after, 1);
+  REQUIRE(f.stats.steps == 1);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(M_PI / 180, axis).toRotationMatrix();
+  long still = 0, stayed = 0, carried = 0, turned = 0;
+  for (size_t v = 0; v < f.ids.size(); ++v) {
+    const auto old = was.find(f.ids[v]);
+    if (old == was.end()) continue;
+    const MixedCell& cell = moving.complex().cell(f.mesh.cells[v]);
+    bool all_still = true, all_moving = true;
+    for (int i = 0; i <= cell.dim; ++i) {
+      const auto b = static_cast<size_t>(cell.balls[static_cast<size_t>(i)]);
+      all_still = all_still && !tail.moving[b];
+      all_moving = all_moving && tail.moving[b];
+    }
+    if (all_still) {
+      ++still;
+      stayed += f.mesh.vertices[v] == old->second;
+    } else if (all_moving) {
+      ++carried;
+      turned += (f.mesh.vertices[v] - (tail.pivot + turn * (old->second - tail.pivot))).norm() <= 1e-9;
+    }
+  }
+  INFO(stayed << " of " << still << " vertices in cells of atoms that stayed are where they were; " << turned << " of "
+              << carried << " in cells of atoms the hinge carried moved with it");
+  CHECK(still > 1000);
+  CHECK(carried > 100);
+  CHECK(stayed >= 0.99 * still);
+  CHECK(turned >= 0.97 * carried);
+  check_frame(moving, after, MovingOptions{}.frames.min_angle);
+}
