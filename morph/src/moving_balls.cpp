@@ -1092,6 +1092,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   if (topology != topology_) {
     topology_changes(complex_, critical_, next, critical, false, local, vanished);
     keep_events(complex_, next, local, vanished);
+    s.events += static_cast<long>(local.changes.size() + vanished.size());
   }  // otherwise the critical cells that came or went are flips and cancelling pairs: no place to remesh
   local.euler_change = topology.euler - topology_.euler;
   if (!vanished.empty() && !drop_vanished(vanished, stayed, moved, lost, settled, local.euler_change))
