@@ -85,6 +85,52 @@ class LocalComponents {
   mutable std::vector<int> parent_;  // halved by root
 };
 
+// The vertices of the one component `near` holds wholly within the sphere
+// that is a sphere itself and none of whose vertices stayed in its cell or
+// is marked in `taken`; empty when there is no such component or more
+// than one.
+std::vector<int> vanishing_component(const SurfaceMesh& mesh, const Split& near,
+                                     const std::vector<char>& stayed_in_cell, const std::vector<char>& taken) {
+  LocalComponents parts;
+  for (int f : near.inside) {
+    const auto& t = mesh.triangles[static_cast<size_t>(f)];
+    const int a = parts.index(t[0]);
+    parts.join(a, parts.index(t[1]));
+    parts.join(a, parts.index(t[2]));
+  }
+  // Per root: vertices, triangles, and whether it is out (a vertex stayed
+  // in its cell or is taken, or a triangle of it reaches beyond the sphere).
+  std::vector<long> vertices(parts.size(), 0), triangles(parts.size(), 0);
+  std::vector<char> out(parts.size(), 0);
+  for (const auto& [v, i] : parts.dense()) {
+    const auto r = static_cast<size_t>(parts.root(i));
+    ++vertices[r];
+    if (stayed_in_cell[static_cast<size_t>(v)] || taken[static_cast<size_t>(v)]) out[r] = 1;
+  }
+  for (int f : near.inside) {
+    const int corner = mesh.triangles[static_cast<size_t>(f)][0];
+    ++triangles[static_cast<size_t>(parts.find_vertex(corner))];
+  }
+  for (int f : near.straddling)
+    for (int v : mesh.triangles[static_cast<size_t>(f)]) {
+      const int r = parts.find_vertex(v);
+      if (r >= 0) out[static_cast<size_t>(r)] = 1;
+    }
+  int candidate = -1, candidates = 0;
+  for (size_t r = 0; r < parts.size(); ++r) {
+    if (parts.root(static_cast<int>(r)) != static_cast<int>(r) || out[r]) continue;
+    // Closed: E = 3F/2, so the Euler characteristic is V - F/2.
+    if (2 * vertices[r] - triangles[r] != 4) continue;
+    candidate = static_cast<int>(r);
+    ++candidates;
+  }
+  std::vector<int> component;
+  if (candidates != 1) return component;
+  for (const auto& [v, i] : parts.dense())
+    if (parts.root(i) == candidate) component.push_back(v);
+  return component;
+}
+
 }  // namespace
 
 std::vector<char> vanishing_components(const SurfaceMesh& mesh, const std::vector<char>& stayed_in_cell,
@@ -93,42 +139,11 @@ std::vector<char> vanishing_components(const SurfaceMesh& mesh, const std::vecto
   found.assign(spheres.size(), 0);
   const std::vector<int> near_any_sphere = triangles_near(mesh, spheres);
   for (size_t k = 0; k < spheres.size(); ++k) {
-    const Split near = split_by(mesh, near_any_sphere, spheres[k]);
-    LocalComponents parts;
-    for (int f : near.inside) {
-      const auto& t = mesh.triangles[static_cast<size_t>(f)];
-      const int a = parts.index(t[0]);
-      parts.join(a, parts.index(t[1]));
-      parts.join(a, parts.index(t[2]));
-    }
-    // Per root: vertices, triangles, and whether it is out (a vertex stayed
-    // in its cell, a triangle of it reaches beyond the sphere, or another
-    // sphere took it already).
-    std::vector<long> vertices(parts.size(), 0), triangles(parts.size(), 0);
-    std::vector<char> out(parts.size(), 0);
-    for (const auto& [v, i] : parts.dense()) {
-      const int r = parts.root(i);
-      ++vertices[static_cast<size_t>(r)];
-      if (stayed_in_cell[static_cast<size_t>(v)] || drop[static_cast<size_t>(v)]) out[static_cast<size_t>(r)] = 1;
-    }
-    for (int f : near.inside) ++triangles[static_cast<size_t>(parts.find_vertex(mesh.triangles[static_cast<size_t>(f)][0]))];
-    for (int f : near.straddling)
-      for (int v : mesh.triangles[static_cast<size_t>(f)]) {
-        const int r = parts.find_vertex(v);
-        if (r >= 0) out[static_cast<size_t>(r)] = 1;
-      }
-    int candidate = -1, candidates = 0;
-    for (size_t r = 0; r < parts.size(); ++r) {
-      if (parts.root(static_cast<int>(r)) != static_cast<int>(r) || out[r]) continue;
-      // Closed: E = 3F/2, so the Euler characteristic is V - F/2.
-      if (2 * vertices[r] - triangles[r] != 4) continue;
-      candidate = static_cast<int>(r);
-      ++candidates;
-    }
-    if (candidates != 1) continue;
+    const std::vector<int> component =
+        vanishing_component(mesh, split_by(mesh, near_any_sphere, spheres[k]), stayed_in_cell, drop);
+    if (component.empty()) continue;
     found[k] = 1;
-    for (const auto& [v, i] : parts.dense())
-      if (parts.root(i) == candidate) drop[static_cast<size_t>(v)] = 1;
+    for (int v : component) drop[static_cast<size_t>(v)] = 1;
   }
   return drop;
 }
