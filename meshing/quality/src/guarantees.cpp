@@ -1,20 +1,60 @@
 #include "skinmesh/quality/guarantees.hpp"
 
 #include "skinmesh/core/skin_complex.hpp"
-#include "skinmesh/core/point_grid.hpp"
+#include "skinmesh/core/cell_grid.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <numeric>
+#include <optional>
 
 namespace skinmesh {
 namespace {
+
+// Points by their exact coordinates: an open-addressing table of their
+// numbers, a quarter full, probed linearly, so that each vertex of a frame
+// finds the frame before's answer at its place in about one memory access.
+class PointIndex {
+ public:
+  explicit PointIndex(const std::vector<Eigen::Vector3d>& points) : points_(points) {
+    size_t size = 16;
+    while (size < 4 * points.size()) size *= 2;
+    slots_.assign(size, -1);
+    for (size_t k = 0; k < points.size(); ++k) {
+      size_t s = slot(points[k]);
+      while (slots_[s] >= 0 && points_[static_cast<size_t>(slots_[s])] != points[k]) s = (s + 1) & (slots_.size() - 1);
+      if (slots_[s] < 0) slots_[s] = static_cast<long>(k);  // a repeated point keeps its first number
+    }
+  }
+  // The number of the point equal to x, or -1.
+  long find(const Eigen::Vector3d& x) const {
+    for (size_t s = slot(x);; s = (s + 1) & (slots_.size() - 1)) {
+      const long k = slots_[s];
+      if (k < 0 || points_[static_cast<size_t>(k)] == x) return k;
+    }
+  }
+
+ private:
+  size_t slot(const Eigen::Vector3d& x) const {
+    uint64_t h = 0;
+    for (int k = 0; k < 3; ++k) {
+      uint64_t bits;
+      std::memcpy(&bits, &x[k], sizeof bits);
+      h = (h ^ bits) * 0x9E3779B97F4A7C15ULL;  // Fibonacci hashing of the coordinates' bits
+      h ^= h >> 29;
+    }
+    return static_cast<size_t>(h) & (slots_.size() - 1);
+  }
+  const std::vector<Eigen::Vector3d>& points_;
+  std::vector<long> slots_;
+};
 
 // Per vertex, the earlier answer that stands for `skin`'s balls
 // (OracleAnswers), or -1: one at the same point whose reach holds no ball
@@ -31,34 +71,32 @@ std::vector<long> standing_answers(const std::vector<Eigen::Vector3d>& vertices,
     return std::max_element(balls.begin(), balls.end(), lighter)->weight;
   };
   if (heaviest(now) > heaviest(earlier.balls)) return out;
-  constexpr double kCell = 4.0;  // Angstrom: about an answer's reach
-  PointGrid<Eigen::Vector3d> changed(kCell);
+  // The changed balls' centres, old and new, in a grid with counts: most
+  // vertices lie where no cell within their answer's reach holds one, and
+  // are decided by one lookup of the summed counts.
+  std::vector<Eigen::Vector3d> changed;
   for (size_t i = 0; i < now.size(); ++i)
     if (now[i].center != earlier.balls[i].center || now[i].weight != earlier.balls[i].weight) {
-      changed.insert(now[i].center, now[i].center);
-      changed.insert(earlier.balls[i].center, earlier.balls[i].center);
+      changed.push_back(now[i].center);
+      changed.push_back(earlier.balls[i].center);
     }
-  // The earlier points in lexicographic order, for finding a vertex's own.
-  std::vector<long> order(earlier.points.size());
-  std::iota(order.begin(), order.end(), 0L);
-  const auto before = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
-  };
-  tbb::parallel_sort(order.begin(), order.end(), [&](long a, long b) {
-    return before(earlier.points[static_cast<size_t>(a)], earlier.points[static_cast<size_t>(b)]);
-  });
+  CellGridOptions grid_options;
+  grid_options.cell = 4.0;  // Angstrom: about an answer's reach
+  grid_options.most_cells = 4.0 * static_cast<double>(vertices.size()) + 4096;
+  grid_options.counts = true;
+  const CellGrid near_changed(changed, {}, Eigen::AlignedBox3d(), grid_options);
+  const PointIndex index(earlier.points);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       const Eigen::Vector3d& x = vertices[v];
-      const auto it = std::lower_bound(order.begin(), order.end(), x, [&](long e, const Eigen::Vector3d& p) {
-        return before(earlier.points[static_cast<size_t>(e)], p);
-      });
-      if (it == order.end() || earlier.points[static_cast<size_t>(*it)] != x) continue;
-      const SkinDistance& d = earlier.distances[static_cast<size_t>(*it)];
+      const long answer = index.find(x);
+      if (answer < 0) continue;
+      const SkinDistance& d = earlier.distances[static_cast<size_t>(answer)];
       if (!d.certified || !std::isfinite(d.reach)) continue;
-      const int span = static_cast<int>(std::ceil(d.reach / kCell));
-      const bool near = changed.any_near(x, span, [&](const Eigen::Vector3d& c) { return (c - x).norm() <= d.reach; });
-      if (!near) out[v] = *it;
+      const std::optional<CellGrid::Cells> cells = near_changed.cells_met(x, d.reach);
+      const bool near = cells && near_changed.count_in(*cells) > 0 &&
+                        near_changed.any_in(*cells, [&](int, const Eigen::Vector3d& c) { return (c - x).norm() <= d.reach; });
+      if (!near) out[v] = answer;
     }
   });
   return out;
