@@ -310,6 +310,20 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   CHECK(CertifiedTriangles(ring, repeated).empty());
   CHECK(changed_count(certified.changed_in(CertifiedTriangles(ring, repeated))) == static_cast<long>(ring.triangles.size()));
   CHECK(changed_count(CertifiedTriangles().changed_in(CertifiedTriangles(ring, ids))) == static_cast<long>(ring.triangles.size()));
+
+  // Ids spread over far more numbers than there are vertices certify
+  // nothing; a vertex under an id past all the certified ones changes
+  // exactly its own triangles.
+  std::vector<long> spread = ids;
+  spread[5] = ids.back() + 100 * static_cast<long>(ids.size());
+  CHECK(CertifiedTriangles(ring, spread).empty());
+  std::vector<long> renamed = ids;
+  renamed[5] = ids.back() + 1;
+  const std::vector<char> new_id = certified.changed_in(CertifiedTriangles(ring, renamed));
+  for (size_t f = 0; f < ring.triangles.size(); ++f) {
+    const auto& t = ring.triangles[f];
+    REQUIRE(new_id[f] == (std::find(t.begin(), t.end(), 5) != t.end()));
+  }
 }
 
 TEST_CASE("self-intersections: CGAL's box intersection where the grid does not suit (needles, a stack), CGAL's count",

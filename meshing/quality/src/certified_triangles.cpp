@@ -1,10 +1,12 @@
-// Certified triangles as vertices sorted by id and triangles by their
-// corners' ids: two frames are compared by merging, in one pass each.
+// Certified triangles as a table of vertices by id and, per vertex, the
+// triangles whose corner of least id it is: the next frame finds each of
+// its triangles by a few reads, in parallel, with no sort.
 #include "skinmesh/quality/certified_triangles.hpp"
 
 #include "skinmesh/core/error.hpp"
 
-#include <tbb/parallel_sort.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 
@@ -12,51 +14,76 @@ namespace skinmesh {
 
 CertifiedTriangles::CertifiedTriangles(const SurfaceMesh& mesh, const std::vector<long>& ids) {
   if (ids.size() != mesh.vertices.size()) contract_error("CertifiedTriangles: one id per vertex");
-  vertex_count_ = mesh.vertices.size();
-  mesh_triangles_ = mesh.triangles;
-  places_.reserve(ids.size());
-  for (size_t v = 0; v < ids.size(); ++v) {
-    const Eigen::Vector3d& p = mesh.vertices[v];
-    places_.push_back({ids[v], p.x(), p.y(), p.z(), static_cast<int>(v)});
-  }
-  tbb::parallel_sort(places_.begin(), places_.end(), [](const Place& a, const Place& b) { return a.id < b.id; });
+  mesh_triangles_ = mesh.triangles;  // the size of changed_in's answer, certified or not
+  if (ids.empty()) return;
+  const auto [low, high] = std::minmax_element(ids.begin(), ids.end());
+  const double spread = static_cast<double>(*high) - static_cast<double>(*low) + 1;
+  if (spread > 8.0 * static_cast<double>(ids.size()) + 4096) return;
+  first_id_ = *low;
   // Index sharing between two triangles is what the exact test reads besides
   // the places (two triangles with a common corner may touch there), so ids
   // must name vertices one to one for the certificate to carry.
-  if (std::adjacent_find(places_.begin(), places_.end(), [](const Place& a, const Place& b) { return a.id == b.id; }) !=
-      places_.end()) {
-    places_.clear();
-    return;
+  vertex_of_id_.assign(static_cast<size_t>(spread), -1);
+  for (size_t v = 0; v < ids.size(); ++v) {
+    int& vertex = vertex_of_id_[static_cast<size_t>(ids[v] - first_id_)];
+    if (vertex >= 0) {
+      vertex_of_id_.clear();
+      return;
+    }
+    vertex = static_cast<int>(v);
   }
-  triangles_.reserve(mesh.triangles.size());
-  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
-    const auto& t = mesh.triangles[f];
-    std::array<long, 3> key{ids[static_cast<size_t>(t[0])], ids[static_cast<size_t>(t[1])], ids[static_cast<size_t>(t[2])]};
-    std::sort(key.begin(), key.end());
-    triangles_.push_back({key, static_cast<int>(f)});
-  }
-  tbb::parallel_sort(triangles_.begin(), triangles_.end(),
-                     [](const Corners& a, const Corners& b) { return a.ids < b.ids; });
+  ids_ = ids;
+  places_ = mesh.vertices;
+  triangle_ids_.resize(mesh_triangles_.size());
+  std::vector<int> lead(mesh_triangles_.size());  // per triangle: its corner of least id
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh_triangles_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t f = r.begin(); f != r.end(); ++f) {
+      const auto& t = mesh_triangles_[f];
+      std::array<long, 3>& key = triangle_ids_[f];
+      key = {ids_[static_cast<size_t>(t[0])], ids_[static_cast<size_t>(t[1])], ids_[static_cast<size_t>(t[2])]};
+      std::sort(key.begin(), key.end());
+      lead[f] = vertex_of_id_[static_cast<size_t>(key[0] - first_id_)];
+    }
+  });
+  first_led_.assign(places_.size() + 1, 0);  // a counting sort by lead
+  for (int v : lead) ++first_led_[static_cast<size_t>(v) + 1];
+  for (size_t v = 1; v < first_led_.size(); ++v) first_led_[v] += first_led_[v - 1];
+  led_.resize(lead.size());
+  std::vector<int> fill(first_led_.begin(), first_led_.end() - 1);
+  for (size_t f = 0; f < lead.size(); ++f) led_[static_cast<size_t>(fill[static_cast<size_t>(lead[f])]++)] = static_cast<int>(f);
+  unique_ids_ = true;
+}
+
+int CertifiedTriangles::vertex_with_id(long id) const {
+  const long k = id - first_id_;
+  return k >= 0 && k < static_cast<long>(vertex_of_id_.size()) ? vertex_of_id_[static_cast<size_t>(k)] : -1;
+}
+
+int CertifiedTriangles::triangle_with_ids(const std::array<long, 3>& ids) const {
+  const int v = vertex_with_id(ids[0]);
+  if (v < 0) return -1;
+  for (int k = first_led_[static_cast<size_t>(v)]; k < first_led_[static_cast<size_t>(v) + 1]; ++k)
+    if (triangle_ids_[static_cast<size_t>(led_[static_cast<size_t>(k)])] == ids) return led_[static_cast<size_t>(k)];
+  return -1;
 }
 
 std::vector<char> CertifiedTriangles::changed_in(const CertifiedTriangles& later) const {
   std::vector<char> out(later.mesh_triangles_.size(), 1);
   if (empty() || later.empty()) return out;
-  std::vector<char> still(later.vertex_count_, 0);  // per vertex of `later`: here, at the same place
-  auto here = places_.begin();
-  for (const Place& p : later.places_) {
-    while (here != places_.end() && here->id < p.id) ++here;
-    still[static_cast<size_t>(p.vertex)] =
-        here != places_.end() && here->id == p.id && here->x == p.x && here->y == p.y && here->z == p.z;
-  }
-  auto had = triangles_.begin();
-  for (const Corners& c : later.triangles_) {
-    while (had != triangles_.end() && had->ids < c.ids) ++had;
-    if (had == triangles_.end() || had->ids != c.ids) continue;
-    const auto& t = later.mesh_triangles_[static_cast<size_t>(c.triangle)];
-    out[static_cast<size_t>(c.triangle)] =
-        !(still[static_cast<size_t>(t[0])] && still[static_cast<size_t>(t[1])] && still[static_cast<size_t>(t[2])]);
-  }
+  std::vector<char> still(later.places_.size(), 0);  // per vertex of `later`: here, at the same place
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, still.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const int here = vertex_with_id(later.ids_[v]);
+      still[v] = here >= 0 && places_[static_cast<size_t>(here)] == later.places_[v];
+    }
+  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t f = r.begin(); f != r.end(); ++f) {
+      const auto& t = later.mesh_triangles_[f];
+      if (still[static_cast<size_t>(t[0])] && still[static_cast<size_t>(t[1])] && still[static_cast<size_t>(t[2])])
+        out[f] = triangle_with_ids(later.triangle_ids_[f]) < 0;
+    }
+  });
   return out;
 }
 

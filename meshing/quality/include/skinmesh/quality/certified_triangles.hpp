@@ -9,6 +9,8 @@
 
 #include "skinmesh/core/surface_mesh.hpp"
 
+#include <Eigen/Core>
+
 #include <array>
 #include <vector>
 
@@ -18,30 +20,31 @@ class CertifiedTriangles {
  public:
   CertifiedTriangles() = default;  // no triangles
   // The triangles of `mesh`, with `ids` per vertex; as certified once
-  // every pair of them was tested and none crosses. Ids that repeat give
-  // no triangles.
+  // every pair of them was tested and none crosses. Ids that repeat, or
+  // spread over more than 8 times as many numbers as there are vertices
+  // (a morph's ids are nearly consecutive), give no triangles.
   CertifiedTriangles(const SurfaceMesh& mesh, const std::vector<long>& ids);
 
-  bool empty() const { return triangles_.empty(); }
+  bool empty() const { return !unique_ids_ || mesh_triangles_.empty(); }
   // Per triangle of `later` (in its mesh's order): 1 unless its corners'
   // ids make one of these triangles and each corner is exactly where it
   // was here. All 1 when either side has no triangles (repeated ids).
   std::vector<char> changed_in(const CertifiedTriangles& later) const;
 
  private:
-  struct Place {
-    long id;
-    double x, y, z;
-    int vertex;  // in the mesh
-  };
-  struct Corners {
-    std::array<long, 3> ids;  // ascending
-    int triangle;             // in the mesh
-  };
-  std::vector<Place> places_;        // by id
-  std::vector<Corners> triangles_;   // by ids
+  int vertex_with_id(long id) const;  // -1: none
+  int triangle_with_ids(const std::array<long, 3>& ids) const;  // -1: none
+
+  bool unique_ids_ = false;
+  long first_id_ = 0;
+  std::vector<long> ids_;                          // per vertex
+  std::vector<Eigen::Vector3d> places_;            // per vertex
+  std::vector<int> vertex_of_id_;                  // per id from first_id_: its vertex, or -1
   std::vector<std::array<int, 3>> mesh_triangles_;
-  size_t vertex_count_ = 0;
+  std::vector<std::array<long, 3>> triangle_ids_;  // per triangle: its corners' ids, ascending
+  // The triangles whose corner of least id is vertex v: led_[first_led_[v]]
+  // up to led_[first_led_[v + 1]].
+  std::vector<int> first_led_, led_;
 };
 
 }  // namespace skinmesh
