@@ -37,19 +37,19 @@ void grade_triangles(const SurfaceMesh& mesh, MeshQuality& q) {
     const Eigen::Vector3d& a = V[t[0]];
     const Eigen::Vector3d& b = V[t[1]];
     const Eigen::Vector3d& c = V[t[2]];
-    const Eigen::Vector3d cross = (b - a).cross(c - a);
-    const double area = 0.5 * cross.norm();
+    const double twice_area = (b - a).cross(c - a).norm();
+    const double area = 0.5 * twice_area;
     q.area += area;
     q.volume += a.dot(b.cross(c)) / 6.0;
     const double la = (b - c).norm(), lb = (c - a).norm(), lc = (a - b).norm();
     const double shortest = std::min({la, lb, lc});
-    auto angle = [](const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
-      return std::atan2((u - p).cross(v - p).norm(), (u - p).dot(v - p)) * kDegrees;
-    };
-    const double A = angle(a, b, c), B = angle(b, c, a), C = angle(c, a, b);
-    const double smallest = std::min({A, B, C});
+    // Every corner's angle is atan2(|u x v|, u . v) of its two edges u, v:
+    // the same |u x v| (twice the area) at each, so the smallest angle is
+    // at the corner of the largest dot product and the largest at the least.
+    const double dots[3] = {(b - a).dot(c - a), (c - b).dot(a - b), (a - c).dot(b - c)};
+    const double smallest = std::atan2(twice_area, std::max({dots[0], dots[1], dots[2]})) * kDegrees;
     q.min_angle = std::min(q.min_angle, smallest);
-    q.max_angle = std::max(q.max_angle, std::max({A, B, C}));
+    q.max_angle = std::max(q.max_angle, std::atan2(twice_area, std::min({dots[0], dots[1], dots[2]})) * kDegrees);
     sum_min_angle += smallest;
     below20 += smallest < 20;
     below10 += smallest < 10;
