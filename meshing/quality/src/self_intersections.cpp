@@ -1,7 +1,12 @@
 // Exact self-intersection count: a uniform grid (or, for boxes of very
 // unequal sizes, CGAL's box intersection) finds the pairs of triangles
-// whose bounding boxes meet, and CGAL's exact predicates decide each pair, on the triangles' vertex indices (no halfedge mesh is built:
-// building one was a tenth of the count). CGAL stays in this file.
+// whose bounding boxes meet, and CGAL's exact predicates decide each pair,
+// on the triangles' vertex indices (no halfedge mesh is built: building one
+// was a tenth of the count). A pair sharing a vertex whose star is the
+// graph of a function over a coordinate plane (graph_stars, proven by
+// exact orientations once a vertex) needs no test of its own: on a quality
+// mesh of a smooth surface nearly every vertex's star is one, and nearly
+// every pair of meeting boxes shares a vertex. CGAL stays in this file.
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include "skinmesh/core/error.hpp"
@@ -17,6 +22,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -78,6 +84,99 @@ bool triangles_cross(const SurfaceMesh& mesh, const std::array<int, 3>& a, const
   const K::Triangle_3 ta(pa[0], pa[1], pa[2]), tb(pb[0], pb[1], pb[2]);
   return CGAL::do_intersect(ta, K::Segment_3(at(pb, ib + 1), at(pb, ib + 2))) ||
          CGAL::do_intersect(tb, K::Segment_3(at(pa, ia + 1), at(pa, ia + 2)));
+}
+
+// Whether the wedges `link` (a, b) about v make one fan that is a graph
+// over a coordinate plane (graph_stars).
+bool star_is_graph(const SurfaceMesh& mesh, int v, const std::vector<std::array<int, 2>>& link) {
+  const size_t k = link.size();
+  if (k < 3) return false;
+  // One cycle: each a starts one wedge and ends one, and following a -> b
+  // from the first wedge returns after k wedges.
+  for (size_t i = 0; i < k; ++i) {
+    int starts = 0, ends = 0;
+    for (const auto& w : link) starts += w[0] == link[i][0], ends += w[1] == link[i][0];
+    if (starts != 1 || ends != 1) return false;
+  }
+  size_t steps = 0;
+  for (int at = link[0][1]; at != link[0][0] && steps <= k; ++steps) {
+    const auto next = std::find_if(link.begin(), link.end(), [&](const std::array<int, 2>& w) { return w[0] == at; });
+    at = (*next)[1];
+  }
+  if (steps + 1 != k) return false;
+  const auto& V = mesh.vertices;
+  const Eigen::Vector3d& c = V[static_cast<size_t>(v)];
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (const auto& w : link) normal += (V[static_cast<size_t>(w[0])] - c).cross(V[static_cast<size_t>(w[1])] - c);
+  int axis = 0;
+  normal.cwiseAbs().maxCoeff(&axis);
+  if (normal[axis] == 0 || !std::isfinite(normal[axis])) return false;
+  // The other two coordinates in cyclic order: looking down the axis, a
+  // wedge whose normal points along +axis turns counterclockwise.
+  const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+  const auto flat = [&](int u) { return K::Point_2(V[static_cast<size_t>(u)][i], V[static_cast<size_t>(u)][j]); };
+  const CGAL::Orientation turn = normal[axis] > 0 ? CGAL::LEFT_TURN : CGAL::RIGHT_TURN;
+  const K::Point_2 centre = flat(v);
+  for (const auto& w : link)
+    if (CGAL::orientation(centre, flat(w[0]), flat(w[1])) != turn) return false;
+  // Every wedge turns less than half a turn, and the wedges' angular
+  // intervals [a, b), end to end round the cycle, cover every direction
+  // as often as the fan winds about the centre. The direction of the first
+  // wedge's a is in a wedge's [a, b) when it is past a (or along a:
+  // collinear, and then b turns from it as from a) and not yet at b. The
+  // first wedge holds it and the wedge ending at its a does not: both are
+  // decided by index (a predicate on a repeated point falls back to exact
+  // arithmetic, and is slow).
+  const int first_a = link[0][0];
+  const K::Point_2 along = flat(first_a);
+  int holding = 1;
+  for (size_t w = 1; w < k; ++w) {
+    const auto& [a, b] = link[w];
+    if (b == first_a) continue;
+    const CGAL::Orientation from_a = CGAL::orientation(centre, flat(a), along);
+    holding += (from_a == turn || from_a == CGAL::COLLINEAR) && CGAL::orientation(centre, along, flat(b)) == turn;
+  }
+  return holding == 1;
+}
+
+// Per vertex, 1 where its star is the graph of a function over one of the
+// coordinate planes: the triangles around v, each (v, a, b) in the mesh's
+// orientation, form one fan whose link a -> b is a single cycle; dropping
+// the coordinate along which their normals' sum is longest, every
+// projected wedge (v, a, b) turns the same way (exact orientations: the
+// projection drops a coordinate, no rounding); and the wedges wind about v
+// once (a ray from v along the first wedge's edge lies in exactly one
+// wedge, each counted half-open). The wedges then tile a star-shaped
+// polygon without overlap, and two triangles of the star meet only where
+// they share v or an edge through v: no pair sharing v needs a test.
+// `wanted`: per vertex, whether its star is asked about.
+std::vector<char> graph_stars(const SurfaceMesh& mesh, const std::vector<char>& wanted) {
+  const size_t n = mesh.vertices.size();
+  std::vector<int> first(n + 1, 0);
+  for (const auto& t : mesh.triangles)
+    for (int v : t) ++first[static_cast<size_t>(v) + 1];
+  for (size_t v = 0; v < n; ++v) first[v + 1] += first[v];
+  std::vector<int> around(static_cast<size_t>(first[n]));
+  {
+    std::vector<int> fill(first.begin(), first.end() - 1);
+    for (size_t f = 0; f < mesh.triangles.size(); ++f)
+      for (int v : mesh.triangles[f]) around[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(f);
+  }
+  std::vector<char> out(n, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<std::array<int, 2>> link;  // per wedge: a, b
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      if (!wanted[v]) continue;
+      link.clear();
+      for (int k = first[v]; k < first[v + 1]; ++k) {
+        const auto& t = mesh.triangles[static_cast<size_t>(around[static_cast<size_t>(k)])];
+        const int at = t[0] == static_cast<int>(v) ? 0 : t[1] == static_cast<int>(v) ? 1 : 2;
+        link.push_back({t[static_cast<size_t>((at + 1) % 3)], t[static_cast<size_t>((at + 2) % 3)]});
+      }
+      out[v] = star_is_graph(mesh, static_cast<int>(v), link);
+    }
+  });
+  return out;
 }
 
 Box box_of(const SurfaceMesh& mesh, int f) {
@@ -143,6 +242,7 @@ constexpr std::ptrdiff_t kBoxCutoff = 2000;
 struct PairCounter {
   const SurfaceMesh& mesh;
   BoxPairs& shared;
+  const std::vector<char>* graph = nullptr;  // per vertex: its star is a graph (graph_stars)
   const std::vector<double>* cut = nullptr;
   size_t slab = 0;
   long crossing = 0, unreported = 0;  // box pairs not yet added to shared.seen
@@ -154,8 +254,17 @@ struct PairCounter {
       unreported = 0;
     }
     if (cut && !cut->empty() && owner_slab(*cut, *x, *y) != slab) return;
-    crossing += triangles_cross(mesh, mesh.triangles[static_cast<size_t>(x->info())],
-                                mesh.triangles[static_cast<size_t>(y->info())]);
+    const std::array<int, 3>& a = mesh.triangles[static_cast<size_t>(x->info())];
+    const std::array<int, 3>& b = mesh.triangles[static_cast<size_t>(y->info())];
+    if (!in_a_graph_star(a, b)) crossing += triangles_cross(mesh, a, b);
+  }
+  // Whether a and b share a vertex whose star is a graph: they meet only
+  // where they share it or an edge through it (graph_stars).
+  bool in_a_graph_star(const std::array<int, 3>& a, const std::array<int, 3>& b) const {
+    if (!graph) return false;
+    for (int u : a)
+      if ((*graph)[static_cast<size_t>(u)] && std::find(b.begin(), b.end(), u) != b.end()) return true;
+    return false;
   }
 };
 
@@ -176,8 +285,8 @@ long count_pairs(PairCounter counter, Run run) {
 // boxes in place); stops (over set) when the slabs together pass the bound
 // on box pairs.
 long count_slab(const SurfaceMesh& mesh, std::vector<const Box*>& slab, size_t k, const std::vector<double>& cut,
-                BoxPairs& shared) {
-  return count_pairs(PairCounter{mesh, shared, &cut, k}, [&](PairCounter& c) {
+                BoxPairs& shared, const std::vector<char>& graph) {
+  return count_pairs(PairCounter{mesh, shared, &graph, &cut, k}, [&](PairCounter& c) {
     CGAL::box_self_intersection_d<CGAL::Sequential_tag>(slab.begin(), slab.end(), std::ref(c), kBoxCutoff);
   });
 }
@@ -281,7 +390,8 @@ class BoxGrid {
 
   // The crossing pairs of boxes that meet, at least one of them among the
   // first `wanted`; throws OverBound (through `shared`) past the bound.
-  long count(const SurfaceMesh& mesh, const std::vector<const Box*>& boxes, size_t wanted, BoxPairs& shared) const {
+  long count(const SurfaceMesh& mesh, const std::vector<const Box*>& boxes, size_t wanted, BoxPairs& shared,
+             const std::vector<char>& graph) const {
     const auto meet = [](const Box& x, const Box& y) {
       for (int k = 0; k < 3; ++k)
         if (x.max_coord(k) < y.min_coord(k) || y.max_coord(k) < x.min_coord(k)) return false;
@@ -290,7 +400,7 @@ class BoxGrid {
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, start_.size() - 1, 512), 0L,
         [&](const tbb::blocked_range<size_t>& r, long sum) {
-          PairCounter counter{mesh, shared};
+          PairCounter counter{mesh, shared, &graph};
           for (size_t c = r.begin(); c != r.end(); ++c)
             for (size_t a = start_[c]; a < start_[c + 1]; ++a) {
               const Item& p = items_[a];
@@ -350,11 +460,11 @@ class BoxGrid {
 // The crossing pairs the grid finds (see BoxGrid), or nothing when the
 // grid does not suit the boxes.
 std::optional<long> count_by_grid(const SurfaceMesh& mesh, const std::vector<const Box*>& boxes, size_t wanted,
-                                  BoxPairs& shared) {
+                                  BoxPairs& shared, const std::vector<char>& graph) {
   BoxGrid grid;
   if (!grid.build(boxes)) return std::nullopt;
   try {
-    return grid.count(mesh, boxes, wanted, shared);
+    return grid.count(mesh, boxes, wanted, shared, graph);
   } catch (const OverBound&) {
     shared.over = true;
     return 0L;
@@ -389,7 +499,8 @@ SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max
     result.pairs = pairs;
     return result;
   };
-  if (const std::optional<long> pairs = count_by_grid(mesh, every, every.size(), shared)) {
+  const std::vector<char> graph = graph_stars(mesh, std::vector<char>(mesh.vertices.size(), 1));
+  if (const std::optional<long> pairs = count_by_grid(mesh, every, every.size(), shared, graph)) {
     result.by_grid = true;
     return counted(*pairs);
   }
@@ -399,7 +510,7 @@ SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max
   std::vector<double> cut;
   std::vector<std::vector<const Box*>> slab = cut_into_slabs(boxes, slabs, cut);
   std::vector<long> crossing(slabs, 0);
-  tbb::parallel_for(size_t{0}, slabs, [&](size_t k) { crossing[k] = count_slab(mesh, slab[k], k, cut, shared); });
+  tbb::parallel_for(size_t{0}, slabs, [&](size_t k) { crossing[k] = count_slab(mesh, slab[k], k, cut, shared, graph); });
   long pairs = 0;
   for (long c : crossing) pairs += c;
   return counted(pairs);
@@ -480,7 +591,13 @@ SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, 
   };
   std::vector<const Box*> wanted = among;  // the changed boxes, then the unchanged ones near them
   wanted.insert(wanted.end(), unchanged.begin(), unchanged.end());
-  if (const std::optional<long> pairs = count_by_grid(mesh, wanted, among.size(), shared)) {
+  // A pair with a changed triangle shares only that triangle's corners.
+  std::vector<char> corners(mesh.vertices.size(), 0);
+  for (size_t f = 0; f < changed.size(); ++f)
+    if (changed[f])
+      for (int v : mesh.triangles[f]) corners[static_cast<size_t>(v)] = 1;
+  const std::vector<char> graph = graph_stars(mesh, corners);
+  if (const std::optional<long> pairs = count_by_grid(mesh, wanted, among.size(), shared, graph)) {
     result.by_grid = true;
     return counted(*pairs);
   }
@@ -488,12 +605,12 @@ SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, 
   long both = 0, one = 0;
   tbb::parallel_invoke(
       [&] {
-        both = count_pairs(PairCounter{mesh, shared}, [&](PairCounter& c) {
+        both = count_pairs(PairCounter{mesh, shared, &graph}, [&](PairCounter& c) {
           CGAL::box_self_intersection_d<CGAL::Sequential_tag>(among.begin(), among.end(), std::ref(c), kBoxCutoff);
         });
       },
       [&] {
-        one = count_pairs(PairCounter{mesh, shared}, [&](PairCounter& c) {
+        one = count_pairs(PairCounter{mesh, shared, &graph}, [&](PairCounter& c) {
           CGAL::box_intersection_d<CGAL::Sequential_tag>(near.changed.begin(), near.changed.end(),
                                                          near.unchanged.begin(), near.unchanged.end(), std::ref(c),
                                                          kBoxCutoff);
