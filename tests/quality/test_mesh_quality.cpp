@@ -354,18 +354,26 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   CHECK(changed_count(certified.changed_in(CertifiedTriangles(ring, repeated))) == static_cast<long>(ring.triangles.size()));
   CHECK(changed_count(CertifiedTriangles().changed_in(CertifiedTriangles(ring, ids))) == static_cast<long>(ring.triangles.size()));
 
-  // Ids spread over far more numbers than there are vertices certify
-  // nothing; a vertex under an id past all the certified ones changes
-  // exactly its own triangles.
+  // A vertex under an id past all the certified ones changes exactly its
+  // own triangles: with ids nearly consecutive (those above), and with ids
+  // spread over far more numbers than there are vertices (found another
+  // way), where repeated ids still certify nothing.
   std::vector<long> spread = ids;
-  spread[5] = ids.back() + 100 * static_cast<long>(ids.size());
-  CHECK(CertifiedTriangles(ring, spread).empty());
-  std::vector<long> renamed = ids;
-  renamed[5] = ids.back() + 1;
-  const std::vector<char> new_id = certified.changed_in(CertifiedTriangles(ring, renamed));
-  for (size_t f = 0; f < ring.triangles.size(); ++f) {
-    const auto& t = ring.triangles[f];
-    REQUIRE(new_id[f] == (std::find(t.begin(), t.end(), 5) != t.end()));
+  for (long& id : spread) id *= 1000;
+  const CertifiedTriangles certified_spread(ring, spread);
+  REQUIRE_FALSE(certified_spread.empty());
+  CHECK(changed_count(certified_spread.changed_in(CertifiedTriangles(ring, spread))) == 0);
+  std::vector<long> spread_repeated = spread;
+  spread_repeated[5] = spread_repeated[6];
+  CHECK(CertifiedTriangles(ring, spread_repeated).empty());
+  for (const auto& [before, named] : {std::pair{&certified, &ids}, std::pair{&certified_spread, &spread}}) {
+    std::vector<long> renamed = *named;
+    renamed[5] = *std::max_element(named->begin(), named->end()) + 1;
+    const std::vector<char> new_id = before->changed_in(CertifiedTriangles(ring, renamed));
+    for (size_t f = 0; f < ring.triangles.size(); ++f) {
+      const auto& t = ring.triangles[f];
+      REQUIRE(new_id[f] == (std::find(t.begin(), t.end(), 5) != t.end()));
+    }
   }
 }
 

@@ -20,9 +20,8 @@ class CertifiedTriangles {
  public:
   CertifiedTriangles() = default;  // no triangles
   // The triangles of `mesh`, with `ids` per vertex; as certified once
-  // every pair of them was tested and none crosses. Ids that repeat, or
-  // spread over more than 8 times as many numbers as there are vertices
-  // (a morph's ids are nearly consecutive), give no triangles.
+  // every pair of them was tested and none crosses. Ids that repeat give
+  // no triangles.
   CertifiedTriangles(const SurfaceMesh& mesh, const std::vector<long>& ids);
 
   bool empty() const { return !unique_ids_ || mesh_triangles_.empty(); }
@@ -32,6 +31,7 @@ class CertifiedTriangles {
   std::vector<char> changed_in(const CertifiedTriangles& later) const;
 
  private:
+  bool index_ids();  // vertex_of_id_ or id_slots_ from ids_; false when an id repeats
   int vertex_with_id(long id) const;  // -1: none
   int triangle_with_ids(const std::array<long, 3>& ids) const;  // -1: none
 
@@ -39,7 +39,10 @@ class CertifiedTriangles {
   long first_id_ = 0;
   std::vector<long> ids_;                          // per vertex
   std::vector<Eigen::Vector3d> places_;            // per vertex
-  std::vector<int> vertex_of_id_;                  // per id from first_id_: its vertex, or -1
+  // The vertex of each id: a table indexed by id - first_id_ when the ids
+  // are nearly consecutive (a morph's are), else open addressing over ids_.
+  std::vector<int> vertex_of_id_;
+  std::vector<int> id_slots_;
   std::vector<std::array<int, 3>> mesh_triangles_;
   std::vector<std::array<long, 3>> triangle_ids_;  // per triangle: its corners' ids, ascending
   // The triangles whose corner of least id is vertex v: led_[first_led_[v]]
