@@ -208,6 +208,8 @@ TEST_CASE("self-intersections: folds between neighbours count as CGAL counts the
   CHECK(count_self_intersections(flat) == 0);
 }
 
+namespace {
+
 // A fan of triangles about one centre, (centre, p_k, p_k+1) round the
 // link points (angle in degrees, distance, height), closed.
 SurfaceMesh fan(const std::vector<std::array<double, 3>>& link) {
@@ -219,6 +221,8 @@ SurfaceMesh fan(const std::vector<std::array<double, 3>>& link) {
   for (int k = 0; k < n; ++k) m.triangles.push_back({0, 1 + k, 1 + (k + 1) % n});
   return m;
 }
+
+}  // namespace
 
 TEST_CASE("self-intersections: a vertex's star is spared the pair tests only where it is a graph", "[quality]") {
   // A star whose triangles turn one way about the centre, seen down the
