@@ -4,6 +4,7 @@
 #include "mesh_part.hpp"
 
 #include "skinmesh/core/cell_grid.hpp"
+#include "skinmesh/core/vertex_stars.hpp"
 
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
@@ -22,27 +23,6 @@ namespace {
 
 using Triangle = std::array<int, 3>;
 constexpr signed char kNone = -1;
-
-// The triangles around each vertex, in compressed rows.
-struct VertexStars {
-  std::vector<int> offset, triangles;
-  explicit VertexStars(const SurfaceMesh& mesh) : offset(mesh.vertices.size() + 1, 0) {
-    for (const Triangle& t : mesh.triangles)
-      for (int v : t) ++offset[static_cast<size_t>(v) + 1];
-    for (size_t v = 1; v < offset.size(); ++v) offset[v] += offset[v - 1];
-    triangles.resize(static_cast<size_t>(offset.back()));
-    std::vector<int> fill(offset.begin(), offset.end() - 1);
-    for (int f = 0; f < static_cast<int>(mesh.triangles.size()); ++f)
-      for (int v : mesh.triangles[static_cast<size_t>(f)])
-        triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = f;
-  }
-  bool empty(int v) const { return offset[static_cast<size_t>(v)] == offset[static_cast<size_t>(v) + 1]; }
-  template <class Visit>
-  void each(int v, Visit visit) const {
-    for (int k = offset[static_cast<size_t>(v)]; k < offset[static_cast<size_t>(v) + 1]; ++k)
-      visit(triangles[static_cast<size_t>(k)]);
-  }
-};
 
 // The failing triangles and every triangle within `rings` vertex-rings of them.
 std::vector<char> grow_region(const SurfaceMesh& mesh, const VertexStars& stars, std::vector<char> region, int rings) {

@@ -1,6 +1,8 @@
 // Grading a triangle mesh (see mesh_quality.hpp).
 #include "skinmesh/quality/mesh_quality.hpp"
 
+#include "skinmesh/core/vertex_stars.hpp"
+
 #include "union_find.hpp"
 
 #include <Eigen/Geometry>
@@ -128,16 +130,7 @@ void grade_edges(const SurfaceMesh& mesh, MeshQuality& q) {
 void grade_vertices(const SurfaceMesh& mesh, MeshQuality& q) {
   const auto& T = mesh.triangles;
   const size_t n = mesh.vertices.size();
-  std::vector<int> start(n + 1, 0);
-  for (const auto& t : T)
-    for (int k = 0; k < 3; ++k) ++start[static_cast<size_t>(t[k]) + 1];
-  for (size_t v = 0; v < n; ++v) start[v + 1] += start[v];
-  std::vector<int> around(static_cast<size_t>(start[n]));
-  {
-    std::vector<int> fill(start.begin(), start.end() - 1);
-    for (size_t f = 0; f < T.size(); ++f)
-      for (int k = 0; k < 3; ++k) around[static_cast<size_t>(fill[static_cast<size_t>(T[f][k])]++)] = static_cast<int>(f);
-  }
+  const VertexStars stars(mesh);
   long used = 0;
   std::vector<int> parent;
   std::vector<std::pair<int, int>> first_with_other;  // other endpoint, local triangle
@@ -146,8 +139,8 @@ void grade_vertices(const SurfaceMesh& mesh, MeshQuality& q) {
     return x;
   };
   for (size_t v = 0; v < n; ++v) {
-    const int* fan = around.data() + start[v];
-    const int size = start[v + 1] - start[v];
+    const int* fan = stars.begin(static_cast<int>(v));
+    const int size = stars.size(static_cast<int>(v));
     if (size == 0) {
       ++q.unused_vertices;
       continue;

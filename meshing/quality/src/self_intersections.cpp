@@ -10,6 +10,7 @@
 #include "skinmesh/quality/mesh_quality.hpp"
 
 #include "skinmesh/core/error.hpp"
+#include "skinmesh/core/vertex_stars.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/box_intersection_d.h>
@@ -152,24 +153,15 @@ bool star_is_graph(const SurfaceMesh& mesh, int v, const std::vector<std::array<
 // `wanted`: per vertex, whether its star is asked about.
 std::vector<char> graph_stars(const SurfaceMesh& mesh, const std::vector<char>& wanted) {
   const size_t n = mesh.vertices.size();
-  std::vector<int> first(n + 1, 0);
-  for (const auto& t : mesh.triangles)
-    for (int v : t) ++first[static_cast<size_t>(v) + 1];
-  for (size_t v = 0; v < n; ++v) first[v + 1] += first[v];
-  std::vector<int> around(static_cast<size_t>(first[n]));
-  {
-    std::vector<int> fill(first.begin(), first.end() - 1);
-    for (size_t f = 0; f < mesh.triangles.size(); ++f)
-      for (int v : mesh.triangles[f]) around[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(f);
-  }
+  const VertexStars stars(mesh);
   std::vector<char> out(n, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
     std::vector<std::array<int, 2>> link;  // per wedge: a, b
     for (size_t v = r.begin(); v != r.end(); ++v) {
       if (!wanted[v]) continue;
       link.clear();
-      for (int k = first[v]; k < first[v + 1]; ++k) {
-        const auto& t = mesh.triangles[static_cast<size_t>(around[static_cast<size_t>(k)])];
+      for (const int* f = stars.begin(static_cast<int>(v)); f != stars.end(static_cast<int>(v)); ++f) {
+        const auto& t = mesh.triangles[static_cast<size_t>(*f)];
         const int at = t[0] == static_cast<int>(v) ? 0 : t[1] == static_cast<int>(v) ? 1 : 2;
         link.push_back({t[static_cast<size_t>((at + 1) % 3)], t[static_cast<size_t>((at + 2) % 3)]});
       }
