@@ -3,6 +3,7 @@
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 
 #include <random>
@@ -29,6 +30,12 @@ inline std::vector<Ball> jittered(std::vector<Ball> balls, double amount = 1e-9,
 // Intersecting pairs of triangles by CGAL's self-intersection test over the
 // whole mesh at once, sequential (the grader splits the mesh in two halves).
 long cgal_self_intersecting_pairs(const SurfaceMesh& mesh);
+
+// The skin's topology from CGAL's own alpha shape at alpha = 0
+// (Fixed_alpha_shape_3) of the balls of positive weight and `far_balls`
+// (any weight: what makes a flat set three-dimensional), the reference for
+// skin_topology's classification.
+SkinTopology cgal_alpha_shape_topology(const std::vector<Ball>& balls, const std::vector<Ball>& far_balls);
 
 // Distance from each point to the triangle mesh (CGAL AABB tree).
 std::vector<double> distances_to_mesh(const SurfaceMesh& mesh, const std::vector<Eigen::Vector3d>& points);

@@ -3,9 +3,11 @@
 // dual complex K of that union (H. Edelsbrunner, "Deformable smooth surface
 // design", Discrete Comput. Geom. 21 (1999) 87-115; for every shrink factor
 // in (0,1)). K is the weighted alpha complex at alpha = 0: the simplices of
-// the regular triangulation whose Voronoi faces meet the union. Computed by
-// CGAL's Fixed_alpha_shape_3 (exact predicates), independently of the mixed
-// complex, so that a mesh's topology can be certified against it.
+// the regular triangulation whose Voronoi faces meet the union. Classified
+// on CGAL's regular triangulation with the kernel's exact predicates, as
+// CGAL's alpha shapes classify it (tests/core/test_skin_topology.cpp holds it
+// to CGAL's Fixed_alpha_shape_3), independently of the mixed complex, so that
+// a mesh's topology can be certified against it.
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
