@@ -892,7 +892,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   s.built_ahead += counted;
   if (!built) built.emplace(build_skin_complex(std::move(balls), {options_.shrink}));
   SkinComplex next = std::move(*built);
-  // The certificate's count (CGAL's alpha shape, serial) runs beside the
+  // The certificate's count (skin_topology, serial) runs beside the
   // rest of the step and is waited for before the repair.
   tbb::task_group counting;
   if (!counted) counting.run([&] { topology = skin_topology(next.balls()); });
