@@ -3,6 +3,7 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/error.hpp"
 
+#include "dual_complex.hpp"
 #include "regular_triangulation.hpp"
 
 #include <Eigen/Dense>
@@ -375,6 +376,7 @@ struct SkinComplexBuilder {
           (k > 0 && known[k].cell <= known[k - 1].cell))
         contract_error("with_balls: known cells must be in range and ascending");
     if (out.combinatorics_ != from.combinatorics_ || out.cells_.size() != from.cells_.size()) out = from;
+    out.topology_.reset();
     out.balls_ = std::move(balls);
     compute_geometry(out);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, known.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
@@ -400,7 +402,11 @@ struct SkinComplexBuilder {
       points.emplace_back(Regular::Weighted_point(K::Point_3(b.center.x(), b.center.y(), b.center.z()), b.weight),
                           static_cast<int>(i));
     }
-    const Regular rt(points.begin(), points.end());
+    Regular rt(points.begin(), points.end());
+    const bool all_positive =
+        std::all_of(sc.balls_.begin(), sc.balls_.end(), [](const Ball& b) { return b.weight > 0; });
+    if (options.count_topology && all_positive && rt.dimension() == 3)
+      sc.topology_ = detail::count_dual_complex(rt, sc.balls_.size());
     static std::atomic<unsigned long> builds{0};
     sc.combinatorics_ = ++builds;
     sc.dimension_ = rt.dimension();

@@ -582,6 +582,22 @@ MeshingOptions with_size_margin(MeshingOptions o, double margin) {
   return o;
 }
 
+// The complex builds with the skin's topology counted on its own regular
+// triangulation (the certificate's count: exact predicates, independent of
+// the mixed cells and their geometry, which the mesh follows).
+SkinComplexOptions counting_topology(double shrink) {
+  SkinComplexOptions options;
+  options.shrink = shrink;
+  options.count_topology = true;
+  return options;
+}
+
+// The certificate's count for a complex's balls: the one counted at its
+// build, else skin_topology's.
+SkinTopology topology_of(const SkinComplex& complex) {
+  return complex.topology() ? *complex.topology() : skin_topology(complex.balls());
+}
+
 void check_balls(const std::vector<Ball>& balls, const char* what) {
   for (const Ball& b : balls)
     if (!b.center.allFinite() || !std::isfinite(b.weight)) contract_error(std::string(what) + ": a ball is not finite");
@@ -735,8 +751,8 @@ void MovingBalls::Impl::build_ahead() {
   ahead_.balls = std::move(*after_);
   after_.reset();
   building_ahead_.run([this] {
-    ahead_.complex.emplace(build_skin_complex(ahead_.balls, {options_.shrink}));
-    ahead_.topology = skin_topology(ahead_.complex->balls());
+    ahead_.complex.emplace(build_skin_complex(ahead_.balls, counting_topology(options_.shrink)));
+    ahead_.topology = topology_of(*ahead_.complex);
   });
 }
 
@@ -775,8 +791,8 @@ MovingBalls::Impl::Impl(std::vector<Ball> balls, const MovingOptions& options, d
   if (!(options.max_step > 0) || !(options.continuity >= 0))
     contract_error("MovingBalls: max_step must be positive and continuity non-negative");
   const auto start = Clock::now();
-  complex_ = build_skin_complex(std::move(balls), {options.shrink});
-  topology_ = skin_topology(complex_.balls());
+  complex_ = build_skin_complex(std::move(balls), counting_topology(options.shrink));
+  topology_ = topology_of(complex_);
   critical_ = inside_critical_cells(complex_);
   frame_.stats.seconds_complex = seconds_since(start);
   const auto mesh_start = Clock::now();
@@ -890,12 +906,14 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   SkinTopology topology;
   const bool counted = take_ahead(balls, built, topology);
   s.built_ahead += counted;
-  if (!built) built.emplace(build_skin_complex(std::move(balls), {options_.shrink}));
+  if (!built) built.emplace(build_skin_complex(std::move(balls), counting_topology(options_.shrink)));
   SkinComplex next = std::move(*built);
-  // The certificate's count (skin_topology, serial) runs beside the
-  // rest of the step and is waited for before the repair.
+  // The certificate's count comes with the complex; where the complex could
+  // not count it (a flat triangulation), skin_topology runs beside the rest
+  // of the step and is waited for before the repair.
   tbb::task_group counting;
-  if (!counted) counting.run([&] { topology = skin_topology(next.balls()); });
+  if (!counted && next.topology()) topology = *next.topology();
+  else if (!counted) counting.run([&] { topology = skin_topology(next.balls()); });
   std::vector<int> critical = inside_critical_cells(next);
   const std::vector<Eigen::Matrix3d> rotations = neighbourhood_rotations(complex_, next.balls());
   const std::vector<char> quiet = quiet_balls(complex_, next);

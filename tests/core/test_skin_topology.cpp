@@ -7,6 +7,7 @@
 
 #include "skinmesh/core/balls.hpp"
 #include "skinmesh/core/molecule.hpp"
+#include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_topology.hpp"
 
 #include <catch2/catch.hpp>
@@ -88,4 +89,39 @@ TEST_CASE("skin topology classifies the alpha complex as CGAL's alpha shape does
       CHECK(counted(balls) == reference(balls));
     }
   }
+}
+
+TEST_CASE("a complex built with its topology counts what skin_topology counts, and a moved one forgets it", "[topology]") {
+  SkinComplexOptions counting;
+  counting.count_topology = true;
+  std::mt19937 random(23);
+  for (int set = 0; set < 100; ++set) {
+    const int n = 4 + set % 50;
+    const double box = 2.0 + 0.15 * n;
+    std::uniform_real_distribution<double> at(-box, box), weight(0.3, set % 3 == 0 ? 12.0 : 4.0);
+    std::vector<Ball> balls;
+    for (int i = 0; i < n; ++i) balls.push_back({Eigen::Vector3d(at(random), at(random), at(random)), weight(random)});
+    INFO("set " << set);
+    const SkinComplex complex = build_skin_complex(balls, counting);
+    REQUIRE(complex.topology().has_value());
+    CHECK(complex.topology()->text() == counted(balls));
+  }
+  for (const char* name : {"pept.pdb", "1ubi.pdb", "3al1.pdb", "1ejg.pdb"}) {
+    INFO(name);
+    const std::vector<Ball> balls = balls_from_molecule(read_molecule(test::data_file(name)), 0.5);
+    const SkinComplex complex = build_skin_complex(balls, counting);
+    REQUIRE(complex.topology().has_value());
+    CHECK(complex.topology()->text() == counted(balls));
+    CHECK_FALSE(build_skin_complex(balls).topology().has_value());  // not asked
+    std::vector<Ball> moved = balls;
+    moved[0].center.x() += 0.01;
+    CHECK_FALSE(complex.with_balls(moved).topology().has_value());
+  }
+  // Not counted where the triangulation is flat, or a ball has no body.
+  std::vector<Ball> ring;
+  for (int k = 0; k < 12; ++k) ring.push_back({Eigen::Vector3d(6 * std::cos(k * M_PI / 6), 6 * std::sin(k * M_PI / 6), 0), 4.0});
+  CHECK_FALSE(build_skin_complex(ring, counting).topology().has_value());
+  std::vector<Ball> with_empty = {{Eigen::Vector3d::Zero(), 4.0}, {Eigen::Vector3d(3, 0, 0), 4.0},
+                                  {Eigen::Vector3d(0, 3, 0), 4.0}, {Eigen::Vector3d(0, 0, 3), -1.0}};
+  CHECK_FALSE(build_skin_complex(with_empty, counting).topology().has_value());
 }

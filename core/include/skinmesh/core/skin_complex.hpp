@@ -11,6 +11,7 @@
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
+#include "skinmesh/core/skin_topology.hpp"
 
 #include <Eigen/Core>
 
@@ -65,6 +66,11 @@ struct SkinComplexBuilder;
 
 struct SkinComplexOptions {
   double shrink = 0.5;                     // s in (0,1)
+  // Also count the skin's topology (SkinComplex::topology) from the
+  // complex's own regular triangulation, as skin_topology counts it from
+  // one of its own: done only when every ball has positive weight and the
+  // triangulation is three-dimensional.
+  bool count_topology = false;
 };
 
 class SkinComplex {
@@ -75,6 +81,10 @@ class SkinComplex {
   const MixedCell& cell(int index) const { return cells_[static_cast<size_t>(index)]; }
   int triangulation_dimension() const { return dimension_; }  // of the regular triangulation: 0..3
   const std::vector<int>& hidden_balls() const { return hidden_; }  // redundant balls, no cell of their own
+  // The skin's topology counted at the build (SkinComplexOptions::
+  // count_topology); empty when not counted, and in a complex made by
+  // with_balls (its balls moved, its alpha complex not recounted).
+  const std::optional<SkinTopology>& topology() const { return topology_; }
   std::array<long, 4> cell_counts() const;                          // by dimension of delta_X
   long degenerate_cell_count() const;
   int vertex_cell(int ball) const { return vertex_cell_[static_cast<size_t>(ball)]; }  // -1 if hidden
@@ -190,6 +200,7 @@ class SkinComplex {
 
   double shrink_ = 0.5;
   int dimension_ = -1;
+  std::optional<SkinTopology> topology_;
   std::vector<Ball> balls_;
   std::vector<MixedCell> cells_;
   std::vector<int> hidden_;

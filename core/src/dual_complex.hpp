@@ -1,0 +1,161 @@
+// Private to core/: the skin's topology counted from the dual complex K of
+// the union of balls, classified on a three-dimensional regular
+// triangulation (regular_triangulation.hpp) with the kernel's exact
+// predicates, as CGAL's alpha shapes classify it at alpha = 0: a simplex is
+// in K when a coface is, or when it is Gabriel (its smallest orthogonal
+// sphere bounds no vertex of its cofaces) and that sphere's weighted squared
+// radius is at most 0 (H. Edelsbrunner, "Deformable smooth surface design",
+// Discrete Comput. Geom. 21 (1999) 87-115: the skin's body is homotopy
+// equivalent to K). Only in or out is kept, where CGAL's Fixed_alpha_shape_3
+// keeps four kinds and a map of every edge, which cost twice the
+// triangulation. The radius, a filtered predicate, goes first; the Gabriel
+// test only where it passes. Used by skin_topology (its own triangulation,
+// with four far balls) and by build_skin_complex (the complex's).
+#pragma once
+
+#include "regular_triangulation.hpp"
+
+#include "skinmesh/core/skin_topology.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <utility>
+#include <vector>
+
+namespace skinmesh::detail {
+namespace dual_complex {
+
+struct UnionFind {
+  std::vector<long> parent;
+  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0L); }
+  long find(long x) {
+    while (parent[static_cast<size_t>(x)] != x) x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
+    return x;
+  }
+  void join(long a, long b) { parent[static_cast<size_t>(find(a))] = find(b); }
+};
+
+// Whether the smallest sphere orthogonal to the points has weighted squared radius <= 0.
+template <class... Points>
+bool radius_at_most_zero(const Points&... points) {
+  return RtKernel().compare_weighted_squared_radius_3_object()(points..., 0.0) != CGAL::POSITIVE;
+}
+
+// Counts of K's simplices by dimension, with the vertex components.
+struct Counted {
+  long vertices = 0, edges = 0, triangles = 0, tetrahedra = 0, bodies = 0;
+};
+
+// Cells and facets of K, marked in the cells.
+template <class Rt>
+void mark_cells_and_facets(Rt& rt, Counted& n) {
+  for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c) {
+    c->info().in = radius_at_most_zero(c->vertex(0)->point(), c->vertex(1)->point(), c->vertex(2)->point(),
+                                        c->vertex(3)->point());
+    n.tetrahedra += c->info().in;
+  }
+  for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
+    const typename Rt::Cell_handle c = f->first, other = c->neighbor(f->second);
+    const int i = f->second;
+    bool in = (!rt.is_infinite(c) && c->info().in) || (!rt.is_infinite(other) && other->info().in);
+    if (!in)
+      in = radius_at_most_zero(c->vertex((i + 1) % 4)->point(), c->vertex((i + 2) % 4)->point(),
+                               c->vertex((i + 3) % 4)->point()) &&
+           rt.is_Gabriel(c, i);
+    c->info().facet_in[static_cast<size_t>(i)] = in;
+    other->info().facet_in[static_cast<size_t>(other->index(c))] = in;
+    n.triangles += in;
+  }
+}
+
+// Edges and vertices of K; the vertex components by union-find over K's
+// edges. Each vertex's info is its index, below `indices`.
+template <class Rt>
+void count_edges_and_vertices(const Rt& rt, size_t indices, Counted& n) {
+  const long index = static_cast<long>(indices);
+  // The edges of K's triangles, each once.
+  std::vector<std::pair<long, long>> of_triangles;
+  for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
+    const typename Rt::Cell_handle c = f->first;
+    const int i = f->second;
+    if (!c->info().facet_in[static_cast<size_t>(i)]) continue;
+    for (int k = 1; k < 4; ++k)
+      for (int l = k + 1; l < 4; ++l) {
+        const long a = static_cast<long>(c->vertex((i + k) % 4)->info()), b = static_cast<long>(c->vertex((i + l) % 4)->info());
+        of_triangles.emplace_back(std::min(a, b), std::max(a, b));
+      }
+  }
+  std::sort(of_triangles.begin(), of_triangles.end());
+  of_triangles.erase(std::unique(of_triangles.begin(), of_triangles.end()), of_triangles.end());
+  std::vector<std::pair<long, long>> edges = of_triangles;
+  // Edges of K in no triangle of K (singular).
+  for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e) {
+    const typename Rt::Vertex_handle p = e->first->vertex(e->second), q = e->first->vertex(e->third);
+    const long a = static_cast<long>(p->info()), b = static_cast<long>(q->info());
+    const std::pair<long, long> key(std::min(a, b), std::max(a, b));
+    if (std::binary_search(of_triangles.begin(), of_triangles.end(), key)) continue;
+    if (radius_at_most_zero(p->point(), q->point()) && rt.is_Gabriel(*e)) edges.push_back(key);
+  }
+  n.edges = static_cast<long>(edges.size());
+  std::vector<char> in(static_cast<size_t>(index), 0);
+  UnionFind pieces(static_cast<size_t>(index));
+  for (const auto& [a, b] : edges) {
+    in[static_cast<size_t>(a)] = in[static_cast<size_t>(b)] = 1;
+    pieces.join(a, b);
+  }
+  // A vertex of K on no edge of K (a ball that meets no other).
+  for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) {
+    char& mark = in[static_cast<size_t>(v->info())];
+    if (!mark) mark = radius_at_most_zero(v->point()) && rt.is_Gabriel(typename Rt::Vertex_handle(v));
+  }
+  for (long v = 0; v < index; ++v)
+    if (in[static_cast<size_t>(v)]) {
+      ++n.vertices;
+      n.bodies += pieces.find(v) == v;
+    }
+}
+
+// Components of the body's complement: tetrahedra outside K joined through
+// triangles outside K, every infinite cell one unbounded region. Returns
+// the bounded ones.
+template <class Rt>
+long count_voids(Rt& rt) {
+  long outside = 0;
+  for (auto c = rt.all_cells_begin(); c != rt.all_cells_end(); ++c)
+    c->info().outside = rt.is_infinite(c) || !c->info().in ? outside++ : -1;
+  UnionFind regions(static_cast<size_t>(outside) + 1);  // the last: the unbounded region
+  for (auto c = rt.all_cells_begin(); c != rt.all_cells_end(); ++c) {
+    const long i = c->info().outside;
+    if (i < 0) continue;
+    if (rt.is_infinite(c)) regions.join(i, outside);
+    for (int k = 0; k < 4; ++k) {
+      const long other = c->neighbor(k)->info().outside;
+      if (other >= 0 && (rt.is_infinite(c, k) || !c->info().facet_in[static_cast<size_t>(k)])) regions.join(i, other);
+    }
+  }
+  long voids = 0;
+  const long unbounded = regions.find(outside);
+  for (long i = 0; i < outside; ++i) voids += regions.find(i) == i && i != unbounded;
+  return voids;
+}
+
+}  // namespace dual_complex
+
+// The topology of the skin of the triangulation's balls. The triangulation
+// must be three-dimensional, each vertex's info its index below `indices`,
+// and every ball of positive weight but for balls of negative weight so far
+// away that they take no part in the union's power cells (skin_topology's
+// four); the cells' marks are written.
+template <class Rt>
+SkinTopology count_dual_complex(Rt& rt, size_t indices) {
+  dual_complex::Counted n;
+  dual_complex::mark_cells_and_facets(rt, n);
+  dual_complex::count_edges_and_vertices(rt, indices, n);
+  SkinTopology out;
+  out.voids = dual_complex::count_voids(rt);
+  out.components = n.bodies + out.voids;
+  out.euler = 2 * (n.vertices - n.edges + n.triangles - n.tetrahedra);
+  return out;
+}
+
+}  // namespace skinmesh::detail
