@@ -31,6 +31,16 @@ const std::vector<Ball> kFar = {{Eigen::Vector3d(1e3, 1e3, 1e3), -1.0},
 std::string counted(const std::vector<Ball>& balls) { return skin_topology(balls).text(); }
 std::string reference(const std::vector<Ball>& balls) { return test::cgal_alpha_shape_topology(balls, kFar).text(); }
 
+// n balls in a cube whose side grows with n, of weights 0.3 to `heaviest`:
+// from apart to crowded, some enclosing voids.
+std::vector<Ball> random_set(int n, double heaviest, std::mt19937& random) {
+  const double box = 2.0 + 0.15 * n;
+  std::uniform_real_distribution<double> at(-box, box), weight(0.3, heaviest);
+  std::vector<Ball> balls;
+  for (int i = 0; i < n; ++i) balls.push_back({Eigen::Vector3d(at(random), at(random), at(random)), weight(random)});
+  return balls;
+}
+
 }  // namespace
 
 TEST_CASE("skin topology classifies the alpha complex as CGAL's alpha shape does", "[topology]") {
@@ -38,11 +48,7 @@ TEST_CASE("skin topology classifies the alpha complex as CGAL's alpha shape does
     std::mt19937 random(11);
     long with_voids = 0, with_handles = 0;
     for (int set = 0; set < 300; ++set) {
-      const int n = 4 + set % 60;
-      const double box = 2.0 + 0.15 * n;
-      std::uniform_real_distribution<double> at(-box, box), weight(0.3, set % 3 == 0 ? 12.0 : 4.0);
-      std::vector<Ball> balls;
-      for (int i = 0; i < n; ++i) balls.push_back({Eigen::Vector3d(at(random), at(random), at(random)), weight(random)});
+      const std::vector<Ball> balls = random_set(4 + set % 60, set % 3 == 0 ? 12.0 : 4.0, random);
       INFO("set " << set);
       const SkinTopology topology = skin_topology(balls);
       REQUIRE(topology.text() == reference(balls));
@@ -96,11 +102,7 @@ TEST_CASE("a complex built with its topology counts what skin_topology counts, a
   counting.count_topology = true;
   std::mt19937 random(23);
   for (int set = 0; set < 100; ++set) {
-    const int n = 4 + set % 50;
-    const double box = 2.0 + 0.15 * n;
-    std::uniform_real_distribution<double> at(-box, box), weight(0.3, set % 3 == 0 ? 12.0 : 4.0);
-    std::vector<Ball> balls;
-    for (int i = 0; i < n; ++i) balls.push_back({Eigen::Vector3d(at(random), at(random), at(random)), weight(random)});
+    const std::vector<Ball> balls = random_set(4 + set % 50, set % 3 == 0 ? 12.0 : 4.0, random);
     INFO("set " << set);
     const SkinComplex complex = build_skin_complex(balls, counting);
     REQUIRE(complex.topology().has_value());
