@@ -16,24 +16,14 @@
 #include "regular_triangulation.hpp"
 
 #include "skinmesh/core/skin_topology.hpp"
+#include "skinmesh/core/union_find.hpp"
 
 #include <algorithm>
-#include <numeric>
 #include <utility>
 #include <vector>
 
 namespace skinmesh::detail {
 namespace dual_complex {
-
-struct UnionFind {
-  std::vector<long> parent;
-  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0L); }
-  long find(long x) {
-    while (parent[static_cast<size_t>(x)] != x) x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
-    return x;
-  }
-  void join(long a, long b) { parent[static_cast<size_t>(find(a))] = find(b); }
-};
 
 // Whether the smallest sphere orthogonal to the points has weighted squared radius <= 0.
 template <class... Points>
@@ -98,10 +88,10 @@ void count_edges_and_vertices(const Rt& rt, size_t indices, Counted& n) {
   }
   n.edges = static_cast<long>(edges.size());
   std::vector<char> in(static_cast<size_t>(index), 0);
-  UnionFind pieces(static_cast<size_t>(index));
+  UnionFind<long> pieces(static_cast<size_t>(index));
   for (const auto& [a, b] : edges) {
     in[static_cast<size_t>(a)] = in[static_cast<size_t>(b)] = 1;
-    pieces.join(a, b);
+    pieces.unite(a, b);
   }
   // A vertex of K on no edge of K (a ball that meets no other).
   for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) {
@@ -123,14 +113,14 @@ long count_voids(Rt& rt) {
   long outside = 0;
   for (auto c = rt.all_cells_begin(); c != rt.all_cells_end(); ++c)
     c->info().outside = rt.is_infinite(c) || !c->info().in ? outside++ : -1;
-  UnionFind regions(static_cast<size_t>(outside) + 1);  // the last: the unbounded region
+  UnionFind<long> regions(static_cast<size_t>(outside) + 1);  // the last: the unbounded region
   for (auto c = rt.all_cells_begin(); c != rt.all_cells_end(); ++c) {
     const long i = c->info().outside;
     if (i < 0) continue;
-    if (rt.is_infinite(c)) regions.join(i, outside);
+    if (rt.is_infinite(c)) regions.unite(i, outside);
     for (int k = 0; k < 4; ++k) {
       const long other = c->neighbor(k)->info().outside;
-      if (other >= 0 && (rt.is_infinite(c, k) || !c->info().facet_in[static_cast<size_t>(k)])) regions.join(i, other);
+      if (other >= 0 && (rt.is_infinite(c, k) || !c->info().facet_in[static_cast<size_t>(k)])) regions.unite(i, other);
     }
   }
   long voids = 0;

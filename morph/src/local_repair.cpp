@@ -4,6 +4,7 @@
 #include "mesh_part.hpp"
 
 #include "skinmesh/core/cell_grid.hpp"
+#include "skinmesh/core/union_find.hpp"
 #include "skinmesh/core/vertex_stars.hpp"
 
 #include <Eigen/Geometry>
@@ -400,30 +401,13 @@ std::vector<int> seam_faults(const SurfaceMesh& mesh, const VertexStars& stars, 
 
 // The components of a triangle mesh (vertices counted where a triangle uses them).
 long component_count(const SurfaceMesh& mesh) {
-  std::vector<int> parent(mesh.vertices.size(), -1);
-  const auto root = [&parent](int v) {
-    while (parent[static_cast<size_t>(v)] != v) {
-      int& up = parent[static_cast<size_t>(v)];
-      up = parent[static_cast<size_t>(up)];  // path halving
-      v = up;
-    }
-    return v;
-  };
-  long components = 0;
+  UnionFind<> sets(mesh.vertices.size());
+  std::vector<char> used(mesh.vertices.size(), 0);
   for (const Triangle& t : mesh.triangles)
-    for (int v : t)
-      if (parent[static_cast<size_t>(v)] < 0) {
-        parent[static_cast<size_t>(v)] = v;
-        ++components;
-      }
+    for (int v : t) used[static_cast<size_t>(v)] = 1;
+  long components = std::count(used.begin(), used.end(), 1);
   for (const Triangle& t : mesh.triangles)
-    for (size_t k = 1; k < 3; ++k) {
-      const int a = root(t[0]), b = root(t[k]);
-      if (a != b) {
-        parent[static_cast<size_t>(a)] = b;
-        --components;
-      }
-    }
+    for (size_t k = 1; k < 3; ++k) components -= sets.unite(t[0], t[k]);
   return components;
 }
 
@@ -669,26 +653,21 @@ struct Holding {
 
 Holding holding_pieces(const SurfaceMesh& mesh, const std::vector<char>& region, const Attempt& a) {
   const size_t n = mesh.vertices.size();
-  std::vector<size_t> parent(n + a.added.size());
-  std::iota(parent.begin(), parent.end(), size_t{0});
-  const auto find = [&](size_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  UnionFind<> pieces(n + a.added.size());
   const auto join = [&](const Triangle& t) {
-    for (size_t k = 1; k < 3; ++k) parent[find(static_cast<size_t>(t[k]))] = find(static_cast<size_t>(t[0]));
+    for (size_t k = 1; k < 3; ++k) pieces.unite(t[k], t[0]);
   };
   for (size_t f = 0; f < region.size(); ++f)
     if (region[f]) join(mesh.triangles[f]);
   for (const Triangle& t : a.fresh) join(t);
-  std::vector<char> faulty(parent.size(), 0);
-  for (int v : a.faults) faulty[find(static_cast<size_t>(v))] = 1;
+  std::vector<char> faulty(pieces.size(), 0);
+  for (int v : a.faults) faulty[static_cast<size_t>(pieces.find(v))] = 1;
   Holding h;
   h.region.assign(region.size(), 0);
-  std::vector<char> seen(parent.size(), 0);
+  std::vector<char> seen(pieces.size(), 0);
   for (size_t f = 0; f < region.size(); ++f) {
     if (!region[f]) continue;
-    const size_t root = find(static_cast<size_t>(mesh.triangles[f][0]));
+    const size_t root = static_cast<size_t>(pieces.find(mesh.triangles[f][0]));
     h.region[f] = !faulty[root];
     if (!seen[root]) {
       seen[root] = 1;
@@ -702,7 +681,7 @@ Holding holding_pieces(const SurfaceMesh& mesh, const std::vector<char>& region,
       for (int v : mesh.triangles[f]) own[static_cast<size_t>(v)] = 1;
   h.own = std::count(own.begin(), own.end(), 1);
   h.fresh.resize(a.fresh.size());
-  for (size_t f = 0; f < a.fresh.size(); ++f) h.fresh[f] = !faulty[find(static_cast<size_t>(a.fresh[f][0]))];
+  for (size_t f = 0; f < a.fresh.size(); ++f) h.fresh[f] = !faulty[static_cast<size_t>(pieces.find(a.fresh[f][0]))];
   return h;
 }
 

@@ -2,6 +2,7 @@
 
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"
+#include "skinmesh/core/union_find.hpp"
 
 #include "judge.hpp"
 #include "local_repair.hpp"
@@ -645,33 +646,23 @@ SkinTopology mesh_topology(const SurfaceMesh& mesh) {
   counting.run([&] { edge_count = distinct_edges(mesh); });
   const size_t n = mesh.vertices.size();
   std::vector<char> used(n, 0);
-  // Components by union-find over the triangles' corners, each root the
-  // least vertex of its set (parent[x] <= x), so that one pass in vertex
-  // order flattens it.
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&](int x) {
-    while (parent[static_cast<size_t>(x)] != x)
-      x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
-    return x;
-  };
+  // Components by union-find over the triangles' corners.
+  UnionFind<> sets(n);
   for (const auto& t : mesh.triangles) {
     for (int v : t) used[static_cast<size_t>(v)] = 1;
-    for (size_t k = 1; k < 3; ++k) {
-      const int a = find(t[0]), b = find(t[k]);
-      if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
-    }
+    for (size_t k = 1; k < 3; ++k) sets.unite(t[0], t[k]);
   }
-  for (size_t v = 0; v < n; ++v) parent[v] = parent[static_cast<size_t>(parent[v])];  // each its root
+  std::vector<int> root(n);
+  for (size_t v = 0; v < n; ++v) root[v] = sets.find(static_cast<int>(v));
   std::vector<double> volume(n, 0.0);  // signed, per component root
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
-    volume[static_cast<size_t>(parent[static_cast<size_t>(t[0])])] +=
+    volume[static_cast<size_t>(root[static_cast<size_t>(t[0])])] +=
         a.dot(mesh.vertices[static_cast<size_t>(t[1])].cross(mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
   }
   SkinTopology out;
   for (size_t v = 0; v < n; ++v)
-    if (used[v] && parent[v] == static_cast<int>(v)) {
+    if (used[v] && root[v] == static_cast<int>(v)) {
       ++out.components;
       out.voids += volume[v] < 0;
     }

@@ -1,9 +1,8 @@
 // Grading a triangle mesh (see mesh_quality.hpp).
 #include "skinmesh/quality/mesh_quality.hpp"
 
+#include "skinmesh/core/union_find.hpp"
 #include "skinmesh/core/vertex_stars.hpp"
-
-#include "union_find.hpp"
 
 #include <Eigen/Geometry>
 #include <tbb/parallel_for.h>
@@ -19,8 +18,6 @@ namespace skinmesh {
 namespace {
 
 constexpr double kDegrees = 180.0 / M_PI;
-
-using detail::UnionFind;
 
 uint64_t edge_key(int a, int b) {
   const auto lo = static_cast<uint64_t>(std::min(a, b)), hi = static_cast<uint64_t>(std::max(a, b));
@@ -132,12 +129,8 @@ void grade_vertices(const SurfaceMesh& mesh, MeshQuality& q) {
   const size_t n = mesh.vertices.size();
   const VertexStars stars(mesh);
   long used = 0;
-  std::vector<int> parent;
+  UnionFind<> fans_of;  // the triangles around one vertex, by their place in its star
   std::vector<std::pair<int, int>> first_with_other;  // other endpoint, local triangle
-  auto find = [&](int x) {
-    while (parent[static_cast<size_t>(x)] != x) x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
-    return x;
-  };
   for (size_t v = 0; v < n; ++v) {
     const int* fan = stars.begin(static_cast<int>(v));
     const int size = stars.size(static_cast<int>(v));
@@ -148,8 +141,7 @@ void grade_vertices(const SurfaceMesh& mesh, MeshQuality& q) {
     ++used;
     ++q.valence[size];
     // Fans: triangles around v joined when they share an edge through v.
-    parent.resize(static_cast<size_t>(size));
-    std::iota(parent.begin(), parent.end(), 0);
+    fans_of.reset(static_cast<size_t>(size));
     first_with_other.clear();
     for (int i = 0; i < size; ++i)
       for (int k = 0; k < 3; ++k) {
@@ -160,10 +152,10 @@ void grade_vertices(const SurfaceMesh& mesh, MeshQuality& q) {
         if (it == first_with_other.end())
           first_with_other.emplace_back(w, i);
         else
-          parent[static_cast<size_t>(find(i))] = find(it->second);
+          fans_of.unite(i, it->second);
       }
     long fans = 0;
-    for (int i = 0; i < size; ++i) fans += find(i) == i;
+    for (int i = 0; i < size; ++i) fans += fans_of.find(i) == i;
     if (fans > 1) ++q.nonmanifold_vertices;
   }
   q.vertices = used;
@@ -172,7 +164,7 @@ void grade_vertices(const SurfaceMesh& mesh, MeshQuality& q) {
 }  // namespace
 
 SurfaceComponents surface_components(const SurfaceMesh& mesh) {
-  UnionFind uf(mesh.vertices.size());
+  UnionFind<> uf(mesh.vertices.size());
   for (const auto& t : mesh.triangles) uf.unite(t[0], t[1]), uf.unite(t[1], t[2]);
   SurfaceComponents out;
   std::vector<int> label(mesh.vertices.size(), -1);
