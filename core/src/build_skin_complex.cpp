@@ -403,9 +403,10 @@ struct SkinComplexBuilder {
                           static_cast<int>(i));
     }
     Regular rt(points.begin(), points.end());
-    const bool all_positive =
-        std::all_of(sc.balls_.begin(), sc.balls_.end(), [](const Ball& b) { return b.weight > 0; });
-    if (options.count_topology && all_positive && rt.dimension() == 3)
+    const auto all_positive = [&sc] {
+      return std::all_of(sc.balls_.begin(), sc.balls_.end(), [](const Ball& b) { return b.weight > 0; });
+    };
+    if (options.count_topology && rt.dimension() == 3 && all_positive())
       sc.topology_ = detail::count_dual_complex(rt, sc.balls_.size());
     static std::atomic<unsigned long> builds{0};
     sc.combinatorics_ = ++builds;

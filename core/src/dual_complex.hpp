@@ -36,14 +36,19 @@ struct Counted {
   long vertices = 0, edges = 0, triangles = 0, tetrahedra = 0, bodies = 0;
 };
 
-// Cells and facets of K, marked in the cells.
+// The vertices' indices of an edge, the lesser first.
+using Edge = std::pair<long, long>;
+
+// Cells and facets of K, marked in the cells. Returns the edges of K's
+// triangles, each once, ascending. Each vertex's info is its index.
 template <class Rt>
-void mark_cells_and_facets(Rt& rt, Counted& n) {
+std::vector<Edge> mark_cells_and_facets(Rt& rt, Counted& n) {
   for (auto c = rt.finite_cells_begin(); c != rt.finite_cells_end(); ++c) {
     c->info().in = radius_at_most_zero(c->vertex(0)->point(), c->vertex(1)->point(), c->vertex(2)->point(),
                                         c->vertex(3)->point());
     n.tetrahedra += c->info().in;
   }
+  std::vector<Edge> of_triangles;
   for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
     const typename Rt::Cell_handle c = f->first, other = c->neighbor(f->second);
     const int i = f->second;
@@ -55,34 +60,31 @@ void mark_cells_and_facets(Rt& rt, Counted& n) {
     c->info().facet_in[static_cast<size_t>(i)] = in;
     other->info().facet_in[static_cast<size_t>(other->index(c))] = in;
     n.triangles += in;
-  }
-}
-
-// Edges and vertices of K; the vertex components by union-find over K's
-// edges. Each vertex's info is its index, below `indices`.
-template <class Rt>
-void count_edges_and_vertices(const Rt& rt, size_t indices, Counted& n) {
-  const long index = static_cast<long>(indices);
-  // The edges of K's triangles, each once.
-  std::vector<std::pair<long, long>> of_triangles;
-  for (auto f = rt.finite_facets_begin(); f != rt.finite_facets_end(); ++f) {
-    const typename Rt::Cell_handle c = f->first;
-    const int i = f->second;
-    if (!c->info().facet_in[static_cast<size_t>(i)]) continue;
-    for (int k = 1; k < 4; ++k)
-      for (int l = k + 1; l < 4; ++l) {
-        const long a = static_cast<long>(c->vertex((i + k) % 4)->info()), b = static_cast<long>(c->vertex((i + l) % 4)->info());
-        of_triangles.emplace_back(std::min(a, b), std::max(a, b));
-      }
+    if (in)
+      for (int k = 1; k < 4; ++k)
+        for (int l = k + 1; l < 4; ++l) {
+          const long a = static_cast<long>(c->vertex((i + k) % 4)->info());
+          const long b = static_cast<long>(c->vertex((i + l) % 4)->info());
+          of_triangles.emplace_back(std::min(a, b), std::max(a, b));
+        }
   }
   std::sort(of_triangles.begin(), of_triangles.end());
   of_triangles.erase(std::unique(of_triangles.begin(), of_triangles.end()), of_triangles.end());
-  std::vector<std::pair<long, long>> edges = of_triangles;
+  return of_triangles;
+}
+
+// Edges and vertices of K, given the edges of its triangles
+// (mark_cells_and_facets); the vertex components by union-find over K's
+// edges. Each vertex's info is its index, below `indices`.
+template <class Rt>
+void count_edges_and_vertices(const Rt& rt, size_t indices, const std::vector<Edge>& of_triangles, Counted& n) {
+  const long index = static_cast<long>(indices);
+  std::vector<Edge> edges = of_triangles;
   // Edges of K in no triangle of K (singular).
   for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e) {
     const typename Rt::Vertex_handle p = e->first->vertex(e->second), q = e->first->vertex(e->third);
     const long a = static_cast<long>(p->info()), b = static_cast<long>(q->info());
-    const std::pair<long, long> key(std::min(a, b), std::max(a, b));
+    const Edge key(std::min(a, b), std::max(a, b));
     if (std::binary_search(of_triangles.begin(), of_triangles.end(), key)) continue;
     if (radius_at_most_zero(p->point(), q->point()) && rt.is_Gabriel(*e)) edges.push_back(key);
   }
@@ -139,8 +141,8 @@ long count_voids(Rt& rt) {
 template <class Rt>
 SkinTopology count_dual_complex(Rt& rt, size_t indices) {
   dual_complex::Counted n;
-  dual_complex::mark_cells_and_facets(rt, n);
-  dual_complex::count_edges_and_vertices(rt, indices, n);
+  const std::vector<dual_complex::Edge> of_triangles = dual_complex::mark_cells_and_facets(rt, n);
+  dual_complex::count_edges_and_vertices(rt, indices, of_triangles, n);
   SkinTopology out;
   out.voids = dual_complex::count_voids(rt);
   out.components = n.bodies + out.voids;
