@@ -1,7 +1,7 @@
 // Disjoint sets over 0..n-1 (union-find with path halving): the components
 // of a mesh, the fans around a vertex, the pieces and voids of a complex.
-// The root of a set is its least element, so that after one pass in
-// ascending order every element's find is one step.
+// The root of a set is its least element, whatever order its pairs were
+// joined in.
 #pragma once
 
 #include <algorithm>
