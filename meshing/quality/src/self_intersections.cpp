@@ -393,13 +393,23 @@ class BoxGrid {
         tbb::blocked_range<size_t>(0, start_.size() - 1, 512), 0L,
         [&](const tbb::blocked_range<size_t>& r, long sum) {
           PairCounter counter{mesh, shared, &graph};
+          std::vector<size_t> near;  // the items of the cell whose float boxes meet p's
           for (size_t c = r.begin(); c != r.end(); ++c)
             for (size_t a = start_[c]; a < start_[c + 1]; ++a) {
               const Item& p = items_[a];
               if (static_cast<size_t>(p.box) >= wanted) break;  // a cell's boxes ascend: the rest are not wanted
+              // Written without a branch: whether two boxes of a cell meet
+              // is close to a coin toss, and its mispredicted branch was
+              // most of this loop's time.
+              near.resize(start_[c + 1] - a);
+              size_t found = 0;
               for (size_t b = a + 1; b < start_[c + 1]; ++b) {
-                const Item& q = items_[b];
-                if (!may_meet(p, q) || owner(p, q) != c) continue;
+                near[found] = b;
+                found += may_meet(p, items_[b]);
+              }
+              for (size_t i = 0; i < found; ++i) {
+                const Item& q = items_[near[i]];
+                if (owner(p, q) != c) continue;
                 const Box& x = *boxes[static_cast<size_t>(p.box)];
                 const Box& y = *boxes[static_cast<size_t>(q.box)];
                 if (meet(x, y)) counter(&x, &y);
@@ -432,9 +442,10 @@ class BoxGrid {
     item.box = box;
     return item;
   }
+  // Bitwise and, not &&: one value to branch on (or none, above).
   static bool may_meet(const Item& p, const Item& q) {
-    return !(p.hi[0] < q.lo[0] || q.hi[0] < p.lo[0] || p.hi[1] < q.lo[1] || q.hi[1] < p.lo[1] || p.hi[2] < q.lo[2] ||
-             q.hi[2] < p.lo[2]);
+    return !(p.hi[0] < q.lo[0]) & !(q.hi[0] < p.lo[0]) & !(p.hi[1] < q.lo[1]) & !(q.hi[1] < p.lo[1]) &
+           !(p.hi[2] < q.lo[2]) & !(q.hi[2] < p.lo[2]);
   }
 
   // The cell of the lowest corner of two meeting boxes' intersection: its
@@ -572,7 +583,9 @@ SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, 
   std::vector<const Box*> among;  // the changed boxes
   for (size_t f = 0; f < boxes.size(); ++f)
     if (changed[f]) among.push_back(&boxes[f]);
-  const std::vector<const Box*> unchanged = near_changed(boxes, changed, false).unchanged;
+  const bool all_changed = std::find(changed.begin(), changed.end(), 0) == changed.end();
+  const std::vector<const Box*> unchanged =
+      all_changed ? std::vector<const Box*>() : near_changed(boxes, changed, false).unchanged;
   BoxPairs shared;
   shared.max = max_box_pairs;
   const auto counted = [&](long pairs) {
