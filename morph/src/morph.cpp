@@ -1,6 +1,7 @@
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/core/skin_topology.hpp"
-#include "skinmesh/morph/moving_balls.hpp"  // mesh_topology
+#include "skinmesh/morph/moving_balls.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"  // mesh_topology
 
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"

@@ -2,7 +2,7 @@
 
 #include "skinmesh/core/error.hpp"
 #include "skinmesh/core/stopwatch.hpp"
-#include "skinmesh/core/union_find.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"  // mesh_topology
 
 #include "judge.hpp"
 #include "local_repair.hpp"
@@ -605,72 +605,6 @@ void check_balls(const std::vector<Ball>& balls, const char* what) {
 }
 
 }  // namespace
-
-namespace {
-
-// The distinct edges of `mesh`'s triangles: bucketed by their lower end,
-// each there once per triangle side, counted once per bucket by marking
-// the higher ends already met.
-long distinct_edges(const SurfaceMesh& mesh) {
-  const size_t n = mesh.vertices.size();
-  std::vector<int> first(n + 1, 0), higher(mesh.triangles.size() * 3);
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k)
-      ++first[static_cast<size_t>(std::min(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])) + 1];
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  std::vector<int> fill(first.begin(), first.end() - 1);
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
-      higher[static_cast<size_t>(fill[static_cast<size_t>(std::min(a, b))]++)] = std::max(a, b);
-    }
-  long edges = 0;
-  std::vector<int> seen_from(n, -1);  // the lower end whose bucket last held the vertex
-  for (size_t v = 0; v < n; ++v)
-    for (int k = first[v]; k < first[v + 1]; ++k) {
-      const int b = higher[static_cast<size_t>(k)];
-      if (seen_from[static_cast<size_t>(b)] == static_cast<int>(v)) continue;
-      seen_from[static_cast<size_t>(b)] = static_cast<int>(v);
-      ++edges;
-    }
-  return edges;
-}
-
-}  // namespace
-
-SkinTopology mesh_topology(const SurfaceMesh& mesh) {
-  // The edge count (for the Euler characteristic) on another core, the
-  // components and their volumes here: both only read the mesh.
-  long edge_count = 0;
-  tbb::task_group counting;
-  counting.run([&] { edge_count = distinct_edges(mesh); });
-  const size_t n = mesh.vertices.size();
-  std::vector<char> used(n, 0);
-  // Components by union-find over the triangles' corners.
-  UnionFind<> sets(n);
-  for (const auto& t : mesh.triangles) {
-    for (int v : t) used[static_cast<size_t>(v)] = 1;
-    for (size_t k = 1; k < 3; ++k) sets.unite(t[0], t[k]);
-  }
-  std::vector<int> root(n);
-  for (size_t v = 0; v < n; ++v) root[v] = sets.find(static_cast<int>(v));
-  std::vector<double> volume(n, 0.0);  // signed, per component root
-  for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d& a = mesh.vertices[static_cast<size_t>(t[0])];
-    volume[static_cast<size_t>(root[static_cast<size_t>(t[0])])] +=
-        a.dot(mesh.vertices[static_cast<size_t>(t[1])].cross(mesh.vertices[static_cast<size_t>(t[2])])) / 6.0;
-  }
-  SkinTopology out;
-  for (size_t v = 0; v < n; ++v)
-    if (used[v] && root[v] == static_cast<int>(v)) {
-      ++out.components;
-      out.voids += volume[v] < 0;
-    }
-  const long vertices = std::count(used.begin(), used.end(), 1);
-  counting.wait();
-  out.euler = vertices - edge_count + static_cast<long>(mesh.triangles.size());
-  return out;
-}
 
 // The first internal step advance_to takes from `from` towards `to`: at
 // most max_step for any ball (as advance_to divides the move).

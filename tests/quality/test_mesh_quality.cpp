@@ -25,6 +25,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <numeric>
 #include <random>
 #include <sstream>
 
@@ -688,4 +689,58 @@ TEST_CASE("CGAL's skin mesh of pept: closed, manifold, oriented, no self-interse
   CHECK(q.genus >= 0);
   REQUIRE(q.self_intersections_checked);
   CHECK(q.self_intersecting_pairs == 0);
+}
+
+TEST_CASE("mesh_topology counts meshes built by hand, whatever the vertex numbering", "[quality][topology]") {
+  // A torus of 8 x 6 quads (Euler 0), an octahedron around the origin and a
+  // smaller one inside it turned inward (a void): 3 components, 1 void,
+  // Euler 0 + 2 + 2, counted here by hand.
+  SurfaceMesh mesh;
+  const int rings = 8, around = 6;
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < around; ++j) {
+      const double u = 2 * M_PI * i / rings, w = 2 * M_PI * j / around;
+      mesh.vertices.push_back(Eigen::Vector3d((30 + 4 * std::cos(w)) * std::cos(u), (30 + 4 * std::cos(w)) * std::sin(u), 4 * std::sin(w)));
+    }
+  const auto grid = [&](int i, int j) { return ((i + rings) % rings) * around + (j + around) % around; };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < around; ++j) {
+      mesh.triangles.push_back({grid(i, j), grid(i + 1, j), grid(i + 1, j + 1)});
+      mesh.triangles.push_back({grid(i, j), grid(i + 1, j + 1), grid(i, j + 1)});
+    }
+  const auto octahedron = [&](double r, bool inward) {
+    const int o = static_cast<int>(mesh.vertices.size());
+    for (int axis = 0; axis < 3; ++axis)
+      for (double sign : {1.0, -1.0}) {
+        Eigen::Vector3d p = Eigen::Vector3d::Zero();
+        p[axis] = sign * r;
+        mesh.vertices.push_back(p);
+      }
+    // Vertices o+0..5: +x -x +y -y +z -z; faces turned outward.
+    const std::array<std::array<int, 3>, 8> faces{{{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                                   {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}}};
+    for (auto f : faces) {
+      if (inward) std::swap(f[1], f[2]);
+      mesh.triangles.push_back({o + f[0], o + f[1], o + f[2]});
+    }
+  };
+  octahedron(10, false);
+  octahedron(5, true);
+  CHECK(mesh_topology(mesh) == SkinTopology{3, 1, 4});
+  // The same mesh with its vertices numbered in reverse and in a shuffled
+  // order: the union-find meets its sets from other ends.
+  for (int order = 0; order < 2; ++order) {
+    std::vector<int> to(mesh.vertices.size());
+    std::iota(to.begin(), to.end(), 0);
+    if (order == 0) std::reverse(to.begin(), to.end());
+    else std::shuffle(to.begin(), to.end(), std::mt19937(7));
+    SurfaceMesh renumbered = mesh;
+    for (size_t v = 0; v < to.size(); ++v) renumbered.vertices[static_cast<size_t>(to[v])] = mesh.vertices[v];
+    for (auto& t : renumbered.triangles)
+      for (int& v : t) v = to[static_cast<size_t>(v)];
+    CHECK(mesh_topology(renumbered) == SkinTopology{3, 1, 4});
+  }
+  // A vertex no triangle uses is not counted.
+  mesh.vertices.push_back(Eigen::Vector3d(100, 0, 0));
+  CHECK(mesh_topology(mesh) == SkinTopology{3, 1, 4});
 }

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -179,6 +180,57 @@ SurfaceComponents surface_components(const SurfaceMesh& mesh) {
     out.enclosed_volume[static_cast<size_t>(l)] +=
         V[static_cast<size_t>(t[0])].dot(V[static_cast<size_t>(t[1])].cross(V[static_cast<size_t>(t[2])])) / 6.0;
   }
+  return out;
+}
+
+namespace {
+
+// The distinct edges of `mesh`'s triangles: bucketed by their lower end,
+// each there once per triangle side, counted once per bucket by marking
+// the higher ends already met.
+long distinct_edges(const SurfaceMesh& mesh) {
+  const size_t n = mesh.vertices.size();
+  std::vector<int> first(n + 1, 0), higher(mesh.triangles.size() * 3);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      ++first[static_cast<size_t>(std::min(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])) + 1];
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<int> fill(first.begin(), first.end() - 1);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
+      higher[static_cast<size_t>(fill[static_cast<size_t>(std::min(a, b))]++)] = std::max(a, b);
+    }
+  long edges = 0;
+  std::vector<int> seen_from(n, -1);  // the lower end whose bucket last held the vertex
+  for (size_t v = 0; v < n; ++v)
+    for (int k = first[v]; k < first[v + 1]; ++k) {
+      const int b = higher[static_cast<size_t>(k)];
+      if (seen_from[static_cast<size_t>(b)] == static_cast<int>(v)) continue;
+      seen_from[static_cast<size_t>(b)] = static_cast<int>(v);
+      ++edges;
+    }
+  return edges;
+}
+
+}  // namespace
+
+SkinTopology mesh_topology(const SurfaceMesh& mesh) {
+  // The edge count on another core, the components and their volumes
+  // here: both only read the mesh.
+  long edge_count = 0;
+  tbb::task_group counting;
+  counting.run([&] { edge_count = distinct_edges(mesh); });
+  const SurfaceComponents components = surface_components(mesh);
+  SkinTopology out;
+  out.components = static_cast<long>(components.enclosed_volume.size());
+  for (int c = 0; c < static_cast<int>(out.components); ++c) out.voids += components.is_cavity(c);
+  std::vector<char> used(mesh.vertices.size(), 0);
+  for (const auto& t : mesh.triangles)
+    for (int v : t) used[static_cast<size_t>(v)] = 1;
+  const long vertices = std::count(used.begin(), used.end(), 1);
+  counting.wait();
+  out.euler = vertices - edge_count + static_cast<long>(mesh.triangles.size());
   return out;
 }
 

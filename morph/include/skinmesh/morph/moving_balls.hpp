@@ -158,8 +158,4 @@ class MovingBalls {
   friend void detail::inject_certificate_fault(MovingBalls&, std::function<void(SurfaceMesh&, std::vector<long>&)>);
 };
 
-// Components, voids and Euler characteristic of a closed triangle mesh
-// (voids: components enclosing negative volume, the triangles outward).
-SkinTopology mesh_topology(const SurfaceMesh& mesh);
-
 }  // namespace skinmesh

@@ -4,6 +4,7 @@
 // triangles) and self-intersections.
 #pragma once
 
+#include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 
 #include <map>
@@ -103,6 +104,12 @@ struct SurfaceComponents {
   bool is_cavity(int component) const { return enclosed_volume[static_cast<size_t>(component)] < 0; }
 };
 SurfaceComponents surface_components(const SurfaceMesh& mesh);
+
+// Components, voids and Euler characteristic of a closed triangle mesh
+// (voids: components enclosing negative volume, the triangles outward), as
+// the skin's are counted (skin_topology.hpp): a morph frame's certificate.
+// Only the mesh's numbers; grade_mesh says whether it is closed.
+SkinTopology mesh_topology(const SurfaceMesh& mesh);
 
 // Per component of a closed mesh: whether another component encloses it
 // (the winding number of one of its vertices about that component's
