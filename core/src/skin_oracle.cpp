@@ -170,15 +170,20 @@ int least_phi(const Problem& p, const std::vector<int>& candidates) {
 // added per step); else as the candidate of least objective alone.
 Solution solve_on(const Problem& p, const std::vector<int>& candidates, bool warm = false) {
   const double s = p.s;
-  std::vector<int> S{least_phi(p, candidates)};
-  std::vector<double> l{1.0};
   // After a full step the weights sit at the minimiser on S: the next solve's
   // step is round-off, so go straight to the multipliers.
-  bool at_subproblem_minimum = true;
-  if (warm && candidates.size() > 1) {
+  const bool all = warm && candidates.size() > 1;
+  bool at_subproblem_minimum = !all;
+  std::vector<int> S;
+  std::vector<double> l;
+  S.reserve(kMaxSupport);
+  l.reserve(kMaxSupport);
+  if (all) {
     S = candidates;
     l.assign(S.size(), 1.0 / static_cast<double>(S.size()));
-    at_subproblem_minimum = false;
+  } else {
+    S.push_back(least_phi(p, candidates));
+    l.push_back(1.0);
   }
   for (int iteration = 0; iteration < 200; ++iteration) {
     const int k = static_cast<int>(S.size());
@@ -234,7 +239,7 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates, bool war
       }
       // (A support at capacity cannot happen, see kMaxSupport; were it to,
       // the caller's KKT check against every ball would leave x uncertified.)
-      if (entering < 0 || k == kMaxSupport) return {S, l};
+      if (entering < 0 || k == kMaxSupport) return {std::move(S), std::move(l)};
       S.push_back(entering);
       l.push_back(0.0);
       continue;
@@ -256,7 +261,7 @@ Solution solve_on(const Problem& p, const std::vector<int>& candidates, bool war
       for (double& v : l) v = std::max(v, 0.0) / sum;
     }
   }
-  return {S, l};
+  return {std::move(S), std::move(l)};
 }
 
 // What a solution on some candidates says at x: the residual r = x - Z l, the
