@@ -215,7 +215,6 @@ FrameCheck check_frame(const SurfaceMesh& mesh, const std::vector<long>& ids, co
   o.self_intersections = history.skipped() ? SelfIntersectionCheck::skip : SelfIntersectionCheck::exact;
   o.changed_triangles = history.changed(mesh, ids);
   o.earlier = history.earlier_answers();
-  o.scratch = history.scratch();
   o.report_distances = !skin.oracle;
   FrameCheck c;
   c.guarantees = check_guarantees(mesh, skin, o);

@@ -117,10 +117,9 @@ struct FrameCrossingOptions {
   std::string pairs = "changed";
 };
 // The check's state through a run of frames, checked one after the other:
-// the triangles the self-intersection test certified, the static oracle's
-// answers (OracleAnswers: a frame of moving atoms asks the oracle again
-// only where a ball near a vertex moved, or the vertex did), and the
-// self-intersection test's lists, reused from frame to frame.
+// the triangles the self-intersection test certified, and the static
+// oracle's answers (OracleAnswers: a frame of moving atoms asks the oracle
+// again only where a ball near a vertex moved, or the vertex did).
 class FrameCheckHistory {
  public:
   explicit FrameCheckHistory(FrameCrossingOptions o = {}) : options_(std::move(o)) {}
@@ -129,7 +128,6 @@ class FrameCheckHistory {
   const std::vector<char>* changed(const SurfaceMesh& mesh, const std::vector<long>& ids);
   // The answers of the frame before (null: none).
   const OracleAnswers* earlier_answers() const { return answers_.points.empty() ? nullptr : &answers_; }
-  SelfIntersectionScratch* scratch() { return &scratch_; }
   // After the frame's check: its triangles certified when every guarantee
   // held; its oracle answers kept when the static oracle gave them.
   void checked(const SurfaceMesh& mesh, const SkinReference& skin, GuaranteeReport& report);
@@ -139,7 +137,6 @@ class FrameCheckHistory {
   CertifiedTriangles certified_, now_;
   std::vector<char> changed_;
   OracleAnswers answers_;
-  SelfIntersectionScratch scratch_;
 };
 
 // The frame (ids per vertex) checked against `skin`: every guarantee, the

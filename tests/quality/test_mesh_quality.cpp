@@ -389,55 +389,6 @@ TEST_CASE("self-intersections of changed triangles: with the rest certified, CGA
   }
 }
 
-TEST_CASE("self-intersections: one scratch through meshes of every size and kind gives CGAL's counts", "[quality]") {
-  // A frame check keeps the test's lists from mesh to mesh. Larger meshes
-  // then smaller (a stale tail of boxes or grid cells would be counted),
-  // the grid and CGAL's slabs in turn, the changed triangles and all, each
-  // against CGAL's count over the whole mesh.
-  const auto crossing_rings = [](int around, int across, const Eigen::Vector3d& shift) {
-    SurfaceMesh both = torus(around, across, 3.0, 1.0);
-    const SurfaceMesh other = both;
-    const int base = static_cast<int>(both.vertices.size());
-    for (const auto& v : other.vertices) both.vertices.push_back(v + shift);
-    for (auto t : other.triangles) both.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-    return both;
-  };
-  const auto with_far_triangle = [](SurfaceMesh m) {  // the grid would be too large: CGAL's slabs
-    const int base = static_cast<int>(m.vertices.size());
-    m.vertices.insert(m.vertices.end(), {Eigen::Vector3d(1000, 0, 0), Eigen::Vector3d(1500, 0, 0), Eigen::Vector3d(1000, 500, 0)});
-    m.triangles.push_back({base, base + 1, base + 2});
-    return m;
-  };
-  SurfaceMesh shaken = torus(40, 24, 3.0, 1.0);
-  std::mt19937 random(5);
-  std::uniform_real_distribution<double> shake(-0.3, 0.3);
-  for (size_t v = 5 * 24; v < 9 * 24; ++v) shaken.vertices[v] += Eigen::Vector3d(shake(random), shake(random), shake(random));
-  std::vector<char> moved(shaken.triangles.size(), 0);
-  for (size_t f = 0; f < moved.size(); ++f)
-    for (int v : shaken.triangles[f]) moved[f] |= v >= 5 * 24 && v < 9 * 24;
-  const std::vector<SurfaceMesh> meshes = {crossing_rings(200, 40, {0.05, 0.02, 0.3}), shaken,
-                                           with_far_triangle(crossing_rings(100, 30, {3.0, 0.5, 0.2})), shaken,
-                                           crossing_rings(60, 20, {0.1, 0.0, 0.2}), crossing_rings(200, 40, {4.0, 0, 0})};
-  SelfIntersectionScratch scratch;
-  for (size_t k = 0; k < meshes.size(); ++k) {
-    const SurfaceMesh& m = meshes[k];
-    const long expected = test::cgal_self_intersecting_pairs(m);
-    CAPTURE(k, m.triangles.size(), expected);
-    const SelfIntersectionCount all = check_self_intersections(m, std::numeric_limits<long>::max(), &scratch);
-    CHECK(all.pairs == expected);
-    CHECK(all.by_grid == (k != 2));
-    if (m.triangles.size() == shaken.triangles.size()) {
-      REQUIRE(expected > 0);
-      const SelfIntersectionCount some = check_changed_self_intersections(m, moved, 1'000'000, &scratch);
-      CHECK(some.pairs == expected);
-      CHECK(some.box_pairs < all.box_pairs);
-    }
-    GradeOptions graded;
-    graded.scratch = &scratch;
-    CHECK(grade_mesh(m, graded).self_intersecting_pairs == expected);
-  }
-}
-
 TEST_CASE("self-intersections: CGAL's box intersection where the grid does not suit (needles, a stack), CGAL's count",
           "[quality]") {
   // A certified torus with a shaken band, and 600 new needles (long thin

@@ -149,7 +149,6 @@ GuaranteeReport check_guarantees(const SurfaceMesh& mesh, const SkinReference& s
   GradeOptions grade;
   grade.self_intersections = options.self_intersections;
   grade.changed = options.changed_triangles;
-  grade.scratch = options.scratch;
   // The grade (its exact self-intersection test is serial) beside the
   // oracle's distances (parallel over the vertices) and the skin's alpha
   // complex: together they keep both cores busy.

@@ -317,9 +317,8 @@ MeshQuality grade_mesh(const SurfaceMesh& mesh, const GradeOptions& options) {
                        [&] {
                          const long bound = options.max_box_pairs(static_cast<long>(mesh.triangles.size()));
                          if (exact)
-                           crossing = options.changed
-                                           ? check_changed_self_intersections(mesh, *options.changed, bound, options.scratch)
-                                           : check_self_intersections(mesh, bound, options.scratch);
+                           crossing = options.changed ? check_changed_self_intersections(mesh, *options.changed, bound)
+                                                      : check_self_intersections(mesh, bound);
                        });
   q.components = static_cast<long>(components.enclosed_volume.size());
   q.euler = q.vertices - q.edges + q.triangles;

@@ -372,10 +372,10 @@ class BoxGrid {
     if (comparisons > 256 * n + 1e6) return false;
     for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
     items_.resize(entries);
-    fill_.assign(start_.begin(), start_.end() - 1);
+    std::vector<size_t> fill(start_.begin(), start_.end() - 1);
     for (size_t i = 0; i < boxes.size(); ++i) {
       const Item item = item_of(*boxes[i], static_cast<int>(i));
-      grid_.visit(*boxes[i], [&](size_t c) { return items_[fill_[c]++] = item, false; });
+      grid_.visit(*boxes[i], [&](size_t c) { return items_[fill[c]++] = item, false; });
     }
     return true;
   }
@@ -458,14 +458,13 @@ class BoxGrid {
   GridFrame grid_;
   std::vector<size_t> start_;  // per cell, its first entry in items_ (one more at the end)
   std::vector<Item> items_;    // per cell, its boxes, ascending
-  std::vector<size_t> fill_;   // per cell, where its next box goes while building
 };
 
 // The crossing pairs the grid finds (see BoxGrid), or nothing when the
-// grid does not suit the boxes. `grid`: built anew over the boxes, in the
-// memory of its last build.
+// grid does not suit the boxes.
 std::optional<long> count_by_grid(const SurfaceMesh& mesh, const std::vector<const Box*>& boxes, size_t wanted,
-                                  BoxPairs& shared, const std::vector<char>& graph, BoxGrid& grid) {
+                                  BoxPairs& shared, const std::vector<char>& graph) {
+  BoxGrid grid;
   if (!grid.build(boxes)) return std::nullopt;
   try {
     return grid.count(mesh, boxes, wanted, shared, graph);
@@ -477,50 +476,25 @@ std::optional<long> count_by_grid(const SurfaceMesh& mesh, const std::vector<con
 
 }  // namespace
 
-struct SelfIntersectionScratch::Lists {
-  std::vector<Box> boxes;               // per triangle
-  std::vector<const Box*> among;        // the boxes paired with every other
-  std::vector<const Box*> wanted;       // the boxes the grid is built over
-  BoxGrid grid;
-};
-
-SelfIntersectionScratch::SelfIntersectionScratch() : lists_(std::make_unique<Lists>()) {}
-SelfIntersectionScratch::~SelfIntersectionScratch() = default;
-SelfIntersectionScratch::SelfIntersectionScratch(SelfIntersectionScratch&&) noexcept = default;
-SelfIntersectionScratch& SelfIntersectionScratch::operator=(SelfIntersectionScratch&&) noexcept = default;
-
-namespace {
-
-// The boxes of the mesh's triangles, in `boxes`' memory.
-void fill_boxes(const SurfaceMesh& mesh, std::vector<Box>& boxes) {
-  boxes.clear();
-  boxes.reserve(mesh.triangles.size());
-  for (size_t f = 0; f < mesh.triangles.size(); ++f) boxes.push_back(box_of(mesh, static_cast<int>(f)));
-}
-
-}  // namespace
-
 // CGAL's own parallel mode shuffles the boxes and was slower here. Instead
 // the slabs are checked each as a task of its own (beside the oracle's, so
 // the cores share them). Pairs are counted, never stored: a mesh whose
 // triangles nearly all cross (thousands of copies of one body) has a number
 // of crossing pairs that grows as the square of its size.
-SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max_box_pairs,
-                                               SelfIntersectionScratch* scratch) {
+SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max_box_pairs) {
   SelfIntersectionCount result;
   for (const auto& t : mesh.triangles)
     if (degenerate(mesh, t)) {
       result.degenerate = true;
       return result;
     }
-  SelfIntersectionScratch::Lists fresh;
-  SelfIntersectionScratch::Lists& lists = scratch ? scratch->lists() : fresh;
-  std::vector<Box>& boxes = lists.boxes;
-  fill_boxes(mesh, boxes);
+  std::vector<Box> boxes;
+  boxes.reserve(mesh.triangles.size());
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) boxes.push_back(box_of(mesh, static_cast<int>(f)));
   BoxPairs shared;
   shared.max = max_box_pairs;
-  std::vector<const Box*>& every = lists.wanted;
-  every.clear();
+  std::vector<const Box*> every;
+  every.reserve(boxes.size());
   for (const Box& b : boxes) every.push_back(&b);
   const auto counted = [&](long pairs) {
     result.box_pairs = shared.seen;
@@ -529,7 +503,7 @@ SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max
     return result;
   };
   const std::vector<char> graph = graph_stars(mesh, std::vector<char>(mesh.vertices.size(), 1));
-  if (const std::optional<long> pairs = count_by_grid(mesh, every, every.size(), shared, graph, lists.grid)) {
+  if (const std::optional<long> pairs = count_by_grid(mesh, every, every.size(), shared, graph)) {
     result.by_grid = true;
     return counted(*pairs);
   }
@@ -593,21 +567,20 @@ NearPairs near_changed(const std::vector<Box>& boxes, const std::vector<char>& c
 // changed and an unchanged one near it (one bipartite box intersection),
 // side by side. Pairs of two unchanged triangles are not looked at.
 SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, const std::vector<char>& changed,
-                                                       long max_box_pairs, SelfIntersectionScratch* scratch) {
+                                                       long max_box_pairs) {
   if (changed.size() != mesh.triangles.size())
     contract_error("check_changed_self_intersections: one flag per triangle");
   SelfIntersectionCount result;
-  for (size_t f = 0; f < mesh.triangles.size(); ++f)
+  std::vector<Box> boxes;
+  boxes.reserve(mesh.triangles.size());
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
     if (changed[f] && degenerate(mesh, mesh.triangles[f])) {
       result.degenerate = true;
       return result;
     }
-  SelfIntersectionScratch::Lists fresh;
-  SelfIntersectionScratch::Lists& lists = scratch ? scratch->lists() : fresh;
-  std::vector<Box>& boxes = lists.boxes;
-  fill_boxes(mesh, boxes);
-  std::vector<const Box*>& among = lists.among;  // the changed boxes
-  among.clear();
+    boxes.push_back(box_of(mesh, static_cast<int>(f)));
+  }
+  std::vector<const Box*> among;  // the changed boxes
   for (size_t f = 0; f < boxes.size(); ++f)
     if (changed[f]) among.push_back(&boxes[f]);
   const bool all_changed = std::find(changed.begin(), changed.end(), 0) == changed.end();
@@ -621,8 +594,7 @@ SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, 
     result.pairs = pairs;
     return result;
   };
-  std::vector<const Box*>& wanted = lists.wanted;  // the changed boxes, then the unchanged ones near them
-  wanted.assign(among.begin(), among.end());
+  std::vector<const Box*> wanted = among;  // the changed boxes, then the unchanged ones near them
   wanted.insert(wanted.end(), unchanged.begin(), unchanged.end());
   // A pair with a changed triangle shares only that triangle's corners.
   std::vector<char> corners(mesh.vertices.size(), 0);
@@ -630,7 +602,7 @@ SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, 
     if (changed[f])
       for (int v : mesh.triangles[f]) corners[static_cast<size_t>(v)] = 1;
   const std::vector<char> graph = graph_stars(mesh, corners);
-  if (const std::optional<long> pairs = count_by_grid(mesh, wanted, among.size(), shared, graph, lists.grid)) {
+  if (const std::optional<long> pairs = count_by_grid(mesh, wanted, among.size(), shared, graph)) {
     result.by_grid = true;
     return counted(*pairs);
   }

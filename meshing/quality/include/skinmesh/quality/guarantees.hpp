@@ -60,7 +60,6 @@ struct GuaranteeOptions {
   SelfIntersectionCheck self_intersections = SelfIntersectionCheck::exact;
   // Per triangle, changed since a certified frame (GradeOptions::changed); null: every pair tested.
   const std::vector<char>* changed_triangles = nullptr;
-  SelfIntersectionScratch* scratch = nullptr;  // the test's lists kept between meshes (GradeOptions::scratch)
   bool topology = true;              // components, voids and Euler characteristic those of the skin
   // With the static oracle (SkinReference::oracle empty): earlier answers
   // that stand for these balls are kept (OracleAnswers); null: every vertex asked.

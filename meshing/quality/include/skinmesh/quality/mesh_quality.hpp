@@ -8,7 +8,6 @@
 #include "skinmesh/core/surface_mesh.hpp"
 
 #include <map>
-#include <memory>
 #include <vector>
 
 namespace skinmesh {
@@ -60,25 +59,6 @@ enum class SelfIntersectionCheck { exact, skip };  // exact: CGAL's predicates, 
 inline constexpr double kDefaultBoxPairsPerTriangle = 100;
 inline constexpr long kMinBoxPairs = 1'000'000;
 
-// The lists the exact self-intersection check builds on each call (the
-// triangles' boxes, their grid: tens of bytes a triangle), kept for the
-// next call by a caller that checks one mesh after another (a morph's
-// frames), so that the kernel does not map and zero them again every
-// frame. Holds the largest call's memory until it is destroyed; one call
-// at a time.
-class SelfIntersectionScratch {
- public:
-  SelfIntersectionScratch();
-  ~SelfIntersectionScratch();
-  SelfIntersectionScratch(SelfIntersectionScratch&&) noexcept;
-  SelfIntersectionScratch& operator=(SelfIntersectionScratch&&) noexcept;
-  struct Lists;
-  Lists& lists() { return *lists_; }
-
- private:
-  std::unique_ptr<Lists> lists_;
-};
-
 struct GradeOptions {
   SelfIntersectionCheck self_intersections = SelfIntersectionCheck::exact;
   double max_box_pairs_per_triangle = kDefaultBoxPairsPerTriangle;
@@ -86,7 +66,6 @@ struct GradeOptions {
   // certified (CertifiedTriangles): only pairs with a changed triangle are
   // tested (check_changed_self_intersections). Null: every pair.
   const std::vector<char>* changed = nullptr;
-  SelfIntersectionScratch* scratch = nullptr;  // null: the check's lists are made anew
   // The bound in pairs for a mesh of `triangles` triangles.
   long max_box_pairs(long triangles) const;
 };
@@ -105,14 +84,13 @@ struct SelfIntersectionCount {
   bool over_bound = false;  // stopped after max_box_pairs box pairs: no answer
   bool by_grid = false;     // the box pairs came from the grid, not from CGAL's box intersection
 };
-SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max_box_pairs,
-                                               SelfIntersectionScratch* scratch = nullptr);
+SelfIntersectionCount check_self_intersections(const SurfaceMesh& mesh, long max_box_pairs);
 // The same over the pairs with a `changed` triangle (per triangle, 1 or
 // 0) alone: when the unchanged triangles met only at shared corners in a
 // mesh checked before, where they were (CertifiedTriangles), this is the
 // count over every pair. Degenerate: a changed triangle is.
 SelfIntersectionCount check_changed_self_intersections(const SurfaceMesh& mesh, const std::vector<char>& changed,
-                                                       long max_box_pairs, SelfIntersectionScratch* scratch = nullptr);
+                                                       long max_box_pairs);
 // The same without a bound: the number of crossing pairs, or -1 when a
 // triangle is degenerate, where the question has no answer.
 long count_self_intersections(const SurfaceMesh& mesh);
