@@ -170,15 +170,16 @@ int least_phi(const Problem& p, const std::vector<int>& candidates) {
 // added per step); else as the candidate of least objective alone.
 Solution solve_on(const Problem& p, const std::vector<int>& candidates, bool warm = false) {
   const double s = p.s;
-  // After a full step the weights sit at the minimiser on S: the next solve's
-  // step is round-off, so go straight to the multipliers.
-  const bool all = warm && candidates.size() > 1;
-  bool at_subproblem_minimum = !all;
+  const bool start_on_all = warm && candidates.size() > 1;
+  // A single ball's weight 1 is the minimiser on it, as are the weights
+  // after a full step: the next solve's step is round-off, so go straight
+  // to the multipliers.
+  bool at_subproblem_minimum = !start_on_all;
   std::vector<int> S;
   std::vector<double> l;
   S.reserve(kMaxSupport);
   l.reserve(kMaxSupport);
-  if (all) {
+  if (start_on_all) {
     S = candidates;
     l.assign(S.size(), 1.0 / static_cast<double>(S.size()));
   } else {
