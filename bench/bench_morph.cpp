@@ -96,6 +96,7 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
   MorphOptions options;
   if (!local_repair) {  // c': every failing frame remeshed whole (no edits, no patches)
     options.repair.patch.max_failing_share = 0;
+    options.repair.patch.always_patch_up_to = 0;
     options.repair.edits.enabled = false;
   }
   Morph morph = prepare_morph(p.source, p.target, ts.front(), options);

@@ -69,6 +69,15 @@ inline std::vector<Ball> centred_model(const std::string& path, int model) {
   return balls;
 }
 
+// The share of the frame a morph's step was held to when it was remeshed
+// whole for failing triangles, from FrameStats::remeshed_because ("... the
+// local share (S)"); -1 when it was not remeshed for that.
+inline long remeshed_for_share(const std::string& because) {
+  const std::string marker = "the local share (";
+  const size_t open = because.find(marker);
+  return open == std::string::npos ? -1L : std::stol(because.substr(open + marker.size()));
+}
+
 // The exact B(1/2) of two ball sets, live pairs only (docs/math.md section 4).
 inline std::vector<Ball> midway(const std::vector<Ball>& a, const std::vector<Ball>& b) {
   return interpolated_balls(a, b, live_pairs(a, b), 0.5);

@@ -163,6 +163,7 @@ TEST_CASE("a blend frame remeshed whole is certified against the skin's topology
   const test::TwoBallMorph two;
   MorphOptions options;  // every repair a whole-frame remesh
   options.repair.patch.max_failing_share = 0;
+  options.repair.patch.always_patch_up_to = 0;
   options.repair.edits.enabled = false;
   Morph morph = prepare_morph(two.source, two.target, 0.05, options);
   int faults = 0;

@@ -694,18 +694,13 @@ TEST_CASE("moving balls: a step with few triangles failing after the edits is pa
   // 2k39 model 1 -> 3 (residues 1-10, about 5,300 triangles) in 101 frames,
   // as bench_moving runs it. One step leaves more triangles failing after
   // the edits than 1% of the frame, and is remeshed whole without
-  // PatchPolicy::always_patch_up_to; with it (moving atoms' default) no step
+  // PatchPolicy::always_patch_up_to; with it (the default) no step
   // is remeshed for fewer failing triangles than that, and every frame is
   // certified by the engine as before.
   const auto models = models_1_and_3_of_2k39();
   const std::vector<Ball>& from = models.first;
   const std::vector<Ball>& to = models.second;
   REQUIRE(from.size() == to.size());
-  // The share a step was measured against, from its remeshed_because ("... (S)").
-  const auto share_in = [](const std::string& because) {
-    const size_t open = because.find("the local share (");
-    return open == std::string::npos ? -1L : std::stol(because.substr(open + 17));
-  };
   const auto run = [&](long always_patch_up_to, long& remeshed, long& remeshed_for_share, long& least_share) {
     MovingOptions options;
     options.repair.patch.always_patch_up_to = always_patch_up_to;
@@ -718,7 +713,7 @@ TEST_CASE("moving balls: a step with few triangles failing after the edits is pa
       const MorphFrame& f = moving.advance_to(k == 100 ? to : balls, k / 100.0);
       CHECK(f.stats.topology_certified);
       remeshed += f.stats.remeshed;
-      const long share = share_in(f.stats.remeshed_because);
+      const long share = test::remeshed_for_share(f.stats.remeshed_because);
       if (share >= 0) {
         ++remeshed_for_share;
         least_share = std::min(least_share, share);

@@ -86,7 +86,7 @@ struct MovingOptions {
   bool build_ahead = true;
   RelaxationOptions relaxation;  // for the corners of failing triangles
   // Every threshold of the repair (repair_policy.hpp), as the blend's but
-  // for two. The largest patch: a third of the frame's vertices (with the
+  // for five of the patch's. The largest patch: a third of the frame's vertices (with the
   // patch's context), not 0.9. Moving atoms fail triangles in many places
   // at once (thermal motion: all over the surface), and a patch past a
   // third of the frame cost more than remeshing the frame whole, whether it
@@ -110,7 +110,6 @@ struct MovingOptions {
     r.patch.wider_rings = 1;
     r.patch.local_reach_cap = 6;  // target edge lengths
     r.patch.context_reach = 1.5;  // times the local measure
-    r.patch.always_patch_up_to = 200;  // triangles
     return r;
   }();
 };
