@@ -69,9 +69,10 @@ inline std::vector<Ball> centred_model(const std::string& path, int model) {
   return balls;
 }
 
-// The share of the frame a morph's step was held to when it was remeshed
-// whole for failing triangles, from FrameStats::remeshed_because ("... the
-// local share (S)"); -1 when it was not remeshed for that.
+// How many failing triangles a morph step's patch was allowed (its local
+// share) when the step was remeshed whole for having more, from
+// FrameStats::remeshed_because ("... the local share (S)"); -1 when it was
+// not remeshed for that.
 inline long remeshed_for_share(const std::string& because) {
   const std::string marker = "the local share (";
   const size_t open = because.find(marker);

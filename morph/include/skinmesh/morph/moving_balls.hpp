@@ -86,11 +86,12 @@ struct MovingOptions {
   bool build_ahead = true;
   RelaxationOptions relaxation;  // for the corners of failing triangles
   // Every threshold of the repair (repair_policy.hpp), as the blend's but
-  // for five of the patch's. The largest patch: a third of the frame's vertices (with the
-  // patch's context), not 0.9. Moving atoms fail triangles in many places
-  // at once (thermal motion: all over the surface), and a patch past a
-  // third of the frame cost more than remeshing the frame whole, whether it
-  // succeeded or not (docs/benchmarks.md, moving atoms). A patch's second
+  // for five of the patch's. The largest patch: a third of the frame's
+  // vertices (with the patch's context), not 0.9. Moving atoms fail
+  // triangles in many places at once (thermal motion: all over the
+  // surface), and a patch past a third of the frame cost more than
+  // remeshing the frame whole, whether it succeeded or not
+  // (docs/benchmarks.md, moving atoms). A patch's second
   // attempt meshes only around the first one's faults: bench_moving's 3mht
   // DNA motion (101 frames) spent 44% less time in local patches, its
   // frames 24% less in all; its hinge motion 3% less a frame. A patch that
