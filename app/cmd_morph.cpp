@@ -21,6 +21,7 @@
 #include "skinmesh/core/stopwatch.hpp"
 #include "skinmesh/mesh_io/mesh_write.hpp"
 #include "skinmesh/morph/alignment.hpp"
+#include "skinmesh/morph/blend_topology.hpp"
 #include "skinmesh/morph/matched_motion.hpp"
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/morph/moving_balls.hpp"
@@ -39,6 +40,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace skinmesh::app {
@@ -206,13 +208,17 @@ struct FrameReference {
 // is measured on the complex of B(t)'s balls built from scratch, a regular
 // triangulation, not the morph's overlay); its solve at a vertex starts
 // from the live pairs of the vertex's overlay cell (`starts`, indices into
-// reference.pairs; empty: its own start). The topology from B(t)'s balls.
+// reference.pairs; empty: its own start). The topology from B(t)'s balls,
+// or carried from an earlier frame's count when no critical point of the
+// skin can lie between (blend_topology.hpp).
 FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleStart>& starts,
                              const std::vector<long>& ids, const FrameReference& reference, double t,
-                             double min_angle, FrameCheckHistory& history) {
+                             double min_angle, FrameCheckHistory& history, CarriedTopology& topology) {
   SkinReference skin;
   skin.balls = reference.balls_at(t);
   skin.shrink = reference.shrink;
+  const CountedTopology counted = topology.at(t, skin.balls);
+  skin.topology = counted.topology;
   skin.starts = starts;
   skin.oracle = [&reference, t](const Eigen::Vector3d& x, const OracleStart& start) {
     std::vector<BallPair> pairs;
@@ -221,7 +227,9 @@ FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleSt
     const MorphOracleResult e = reference.oracle.evaluate(x, t, pairs);
     return SkinDistance{e.distance(), e.certified};
   };
-  return check_frame(mesh, ids, skin, min_angle, history);
+  FrameCheck check = check_frame(mesh, ids, skin, min_angle, history);
+  check.topology_counted_at = counted.counted_at;
+  return check;
 }
 
 // The m x n morph's frames.jsonl line: the common fields and its events.
@@ -490,6 +498,7 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
   BlendFrame pending;
   FrameCheck check;
   FrameCheckHistory history(crossing_options);
+  std::optional<CarriedTopology> topology;  // made by the first frame's check, beside the engine's next frame
   tbb::task_group checking;  // after what its task reads: if advance_to throws, it waits before they go
   const auto finish = [&]() {
     checking.wait();
@@ -513,8 +522,11 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
     if (k > 0 && !finish()) return false;
     pending = std::move(made);
     checking.run([&] {  // the check, then the frame's files, beside the next frame
+      if (!topology)
+        topology.emplace(topology_change_windows(morph.middle_complex(), morph.sizes(), reference.source,
+                                                 reference.target, reference.pairs, reference.oracle));
       check = check_blend_frame(pending.frame.mesh, pending.starts, pending.frame.ids, reference, pending.t, min_angle,
-                                history);
+                                history, *topology);
       if (check.holds()) stage_frame(out.outputs, out.dir, pending, out.files);
     });
   }

@@ -102,6 +102,9 @@ void print_progress(ProgressLine& line, const PaceEstimate& pace, size_t total, 
 struct FrameCheck {
   GuaranteeReport guarantees;
   double share_below_bound = 0;
+  // The t of the frame whose balls' skin topology was counted (this frame's,
+  // or an earlier one's carried: blend_topology.hpp); -1: this frame's.
+  double topology_counted_at = -1;
   bool holds() const { return guarantees.all_hold(); }
 };
 // Every vertex of a frame within this of the frame's skin (Angstrom).

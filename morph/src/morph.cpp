@@ -592,6 +592,8 @@ const MorphFrame& Morph::frame() const { return impl_->frame_; }
 const SkinComplex& Morph::complex() const { return impl_->current_; }
 const std::vector<TopologyEvent>& Morph::events() const { return impl_->events_; }
 const std::vector<BallPair>& Morph::pairs() const { return impl_->pairs_; }
+const SkinComplex& Morph::middle_complex() const { return impl_->middle_; }
+const std::vector<CellSize>& Morph::sizes() const { return impl_->sizes_; }
 
 Morph prepare_morph(std::vector<Ball> source, std::vector<Ball> target, double t0, const MorphOptions& options) {
   if (!(t0 >= 0 && t0 < 1)) contract_error("prepare_morph: the first frame must lie in [0,1)");

@@ -867,6 +867,37 @@ TEST_CASE("skinmesh morph near t = 1: the morph oracle certifies every vertex", 
   std::system(("rm -rf " + std::string(pattern)).c_str());
 }
 
+// The blend's check counts the skin's topology afresh only where it may
+// have changed since the last count (blend_topology.hpp): every frame's
+// count, carried or not, is that of its own balls, read back from the
+// balls the command wrote and counted here from scratch.
+TEST_CASE("skinmesh morph --pairs all: a frame's skin topology, carried or counted, is its own balls'", "[cli][morph]") {
+  char pattern[] = "/tmp/skinmesh-morph-carried-XXXXXX";
+  REQUIRE(mkdtemp(pattern) != nullptr);
+  const std::string dir = std::string(pattern) + "/out";
+  const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
+  const Run r = run("--quiet morph " + file + " " + file +
+                    " --source-model 1 --target-model 3 --pairs all --t 0.3,0.31,0.32,0.33,0.34,0.35,0.36,0.37 -o " + dir);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  const auto source = skinmesh::balls_from_molecule(skinmesh::read_molecule(dir + "/source.xyzr"), 0.5);
+  const auto target = skinmesh::balls_from_molecule(skinmesh::read_molecule(dir + "/target.xyzr"), 0.5);
+  const auto pairs = skinmesh::live_pairs(source, target);
+  long carried = 0;
+  for (const nlohmann::json& f : skinmesh::test::frame_lines(dir)) {
+    const double t = f["t"].get<double>(), counted_at = f["skin_topology"]["counted_at_t"].get<double>();
+    INFO("t = " << t << ", counted at " << counted_at);
+    const skinmesh::SkinTopology own = skinmesh::skin_topology(skinmesh::interpolated_balls(source, target, pairs, t));
+    CHECK(f["skin_topology"]["components"] == own.components);
+    CHECK(f["skin_topology"]["voids"] == own.voids);
+    CHECK(f["skin_topology"]["euler"] == own.euler);
+    CHECK(counted_at <= t);
+    carried += counted_at < t;
+  }
+  CHECK(carried >= 4);
+  std::system(("rm -rf " + std::string(pattern)).c_str());
+}
+
 // An interrupted morph leaves nothing: the frames staged so far, their
 // temporaries and the directory it made are removed, and the process ends
 // by the signal. The signal is sent once a frame's temporary exists.

@@ -171,6 +171,10 @@ class Morph {
   const SkinComplex& complex() const;
   const std::vector<TopologyEvent>& events() const;
   const std::vector<BallPair>& pairs() const;
+  // The complex of B(1/2) of the live pairs, whose cells every frame in
+  // (0,1) has, and per cell its size and centre as functions of t.
+  const SkinComplex& middle_complex() const;
+  const std::vector<CellSize>& sizes() const;
 
   // A Morph moves; it is not copied (its state holds three complexes).
   Morph(Morph&&) noexcept;
