@@ -56,6 +56,16 @@ std::vector<BallPair> cell_pairs(const MixedCell& cell, const std::vector<BallPa
   return own;
 }
 
+// Each cell's size R2 at t, from `middle` moved to B(t); the moved complex is let go at once.
+std::vector<double> sizes_at(const SkinComplex& middle, const std::vector<Ball>& source, const std::vector<Ball>& target,
+                             const std::vector<BallPair>& pairs, double t) {
+  const SkinComplex moved = middle.with_balls(interpolated_balls(source, target, pairs, t));
+  std::vector<double> sizes;
+  sizes.reserve(moved.cells().size());
+  for (const MixedCell& cell : moved.cells()) sizes.push_back(cell.R2);
+  return sizes;
+}
+
 void merge(std::vector<std::pair<double, double>>& windows) {
   std::sort(windows.begin(), windows.end());
   std::vector<std::pair<double, double>> merged;
@@ -81,12 +91,12 @@ TopologyWindows topology_change_windows(const SkinComplex& middle, const std::ve
                                         const std::vector<BallPair>& pairs, const MorphOracle& oracle,
                                         const TopologyWindowOptions& options) {
   // Two sizes more than cell_sizes fitted its curves to measure each curve's error.
-  const SkinComplex at_04 = middle.with_balls(interpolated_balls(source, target, pairs, 0.4));
-  const SkinComplex at_06 = middle.with_balls(interpolated_balls(source, target, pairs, 0.6));
+  const std::vector<double> at_04 = sizes_at(middle, source, target, pairs, 0.4);
+  const std::vector<double> at_06 = sizes_at(middle, source, target, pairs, 0.6);
   TopologyWindows out;
   for (size_t c = 0; c < sizes.size(); ++c) {
     const CellSize& q = sizes[c];
-    const double error = std::max(std::abs(q.at(0.4) - at_04.cells()[c].R2), std::abs(q.at(0.6) - at_06.cells()[c].R2));
+    const double error = std::max(std::abs(q.at(0.4) - at_04[c]), std::abs(q.at(0.6) - at_06[c]));
     // An overlay cell's curve is a quadratic whatever its error (which then widens its windows).
     if (!q.overlay_cell && !(error <= options.not_quadratic_above)) continue;
     ++out.curves;
