@@ -2,6 +2,9 @@
 
 #include "skinmesh/core/quadratic.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -94,20 +97,27 @@ TopologyWindows topology_change_windows(const SkinComplex& middle, const std::ve
   const std::vector<double> at_04 = sizes_at(middle, source, target, pairs, 0.4);
   const std::vector<double> at_06 = sizes_at(middle, source, target, pairs, 0.6);
   TopologyWindows out;
+  std::vector<std::pair<size_t, NearRoot>> roots;  // (cell, root)
   for (size_t c = 0; c < sizes.size(); ++c) {
     const CellSize& q = sizes[c];
     const double error = std::max(std::abs(q.at(0.4) - at_04[c]), std::abs(q.at(0.6) - at_06[c]));
     // An overlay cell's curve is a quadratic whatever its error (which then widens its windows).
     if (!q.overlay_cell && !(error <= options.not_quadratic_above)) continue;
     ++out.curves;
-    const std::vector<BallPair> start = cell_pairs(middle.cells()[c], pairs);
-    for (const NearRoot& root : near_roots(q, 1e-9 + 10 * error)) {
-      if (root.t + root.half_width <= 0 || root.t - root.half_width >= 1) continue;
-      ++out.roots;
-      if (may_be_critical(q, root, start, oracle, options.gradient_below))
-        out.windows.emplace_back(root.t - root.half_width, root.t + root.half_width);
-    }
+    for (const NearRoot& root : near_roots(q, 1e-9 + 10 * error))
+      if (root.t + root.half_width > 0 && root.t - root.half_width < 1) roots.emplace_back(c, root);
   }
+  out.roots = static_cast<long>(roots.size());
+  std::vector<char> critical(roots.size(), 0);  // an oracle solve each: tens of thousands on a large pair
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const auto& [c, root] = roots[k];
+      critical[k] = may_be_critical(sizes[c], root, cell_pairs(middle.cells()[c], pairs), oracle, options.gradient_below);
+    }
+  });
+  for (size_t k = 0; k < roots.size(); ++k)
+    if (critical[k]) out.windows.emplace_back(roots[k].second.t - roots[k].second.half_width,
+                                              roots[k].second.t + roots[k].second.half_width);
   merge(out.windows);
   return out;
 }

@@ -6,7 +6,6 @@
 #include "two_balls.hpp"
 
 #include "skinmesh/core/interpolation.hpp"
-#include "skinmesh/core/molecule.hpp"
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/skin_topology.hpp"
@@ -19,13 +18,7 @@ using namespace skinmesh;
 
 namespace {
 
-std::vector<Ball> molecule_balls(const char* file, int model = 1) {
-  ReadOptions read;
-  read.model = model;
-  std::vector<Ball> balls = balls_from_molecule(read_molecule(test::data_file(file), read), 0.5);
-  centre_balls(balls);
-  return balls;
-}
+std::vector<Ball> molecule_balls(const char* file, int model = 1) { return test::centred_model(test::data_file(file), model); }
 
 TopologyWindows windows_of(const std::vector<Ball>& source, const std::vector<Ball>& target) {
   const std::vector<BallPair> pairs = live_pairs(source, target);
