@@ -60,8 +60,8 @@ std::vector<BallPair> cell_pairs(const MixedCell& cell, const std::vector<BallPa
 }
 
 // Each cell's size R2 at t, from `middle` moved to B(t); the moved complex is let go at once.
-std::vector<double> sizes_at(const SkinComplex& middle, const std::vector<Ball>& source, const std::vector<Ball>& target,
-                             const std::vector<BallPair>& pairs, double t) {
+std::vector<double> sizes_at(const SkinComplex& middle, const std::vector<Ball>& source,
+                             const std::vector<Ball>& target, const std::vector<BallPair>& pairs, double t) {
   const SkinComplex moved = middle.with_balls(interpolated_balls(source, target, pairs, t));
   std::vector<double> sizes;
   sizes.reserve(moved.cells().size());
@@ -73,8 +73,8 @@ void merge(std::vector<std::pair<double, double>>& windows) {
   std::sort(windows.begin(), windows.end());
   std::vector<std::pair<double, double>> merged;
   for (const auto& w : windows) {
-    if (!merged.empty() && w.first <= merged.back().second) merged.back().second = std::max(merged.back().second, w.second);
-    else merged.push_back(w);
+    if (merged.empty() || w.first > merged.back().second) merged.push_back(w);
+    else merged.back().second = std::max(merged.back().second, w.second);
   }
   windows = std::move(merged);
 }
@@ -112,7 +112,8 @@ TopologyWindows topology_change_windows(const SkinComplex& middle, const std::ve
   tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
       const auto& [c, root] = roots[k];
-      critical[k] = may_be_critical(sizes[c], root, cell_pairs(middle.cells()[c], pairs), oracle, options.gradient_below);
+      const std::vector<BallPair> start = cell_pairs(middle.cells()[c], pairs);
+      critical[k] = may_be_critical(sizes[c], root, start, oracle, options.gradient_below);
     }
   });
   for (size_t k = 0; k < roots.size(); ++k)

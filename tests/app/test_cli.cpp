@@ -871,13 +871,14 @@ TEST_CASE("skinmesh morph near t = 1: the morph oracle certifies every vertex", 
 // have changed since the last count (blend_topology.hpp): every frame's
 // count, carried or not, is that of its own balls, read back from the
 // balls the command wrote and counted here from scratch.
-TEST_CASE("skinmesh morph --pairs all: a frame's skin topology, carried or counted, is its own balls'", "[cli][morph]") {
+TEST_CASE("skinmesh morph --pairs all: a frame's skin topology, carried or counted, is its own balls'",
+          "[cli][morph]") {
   char pattern[] = "/tmp/skinmesh-morph-carried-XXXXXX";
   REQUIRE(mkdtemp(pattern) != nullptr);
   const std::string dir = std::string(pattern) + "/out";
   const std::string file = skinmesh::test::data_file("2k39_3models.pdb");
-  const Run r = run("--quiet morph " + file + " " + file +
-                    " --source-model 1 --target-model 3 --pairs all --t 0.3,0.31,0.32,0.33,0.34,0.35,0.36,0.37 -o " + dir);
+  const Run r = run("--quiet morph " + file + " " + file + " --source-model 1 --target-model 3 --pairs all" +
+                    " --t 0.3,0.31,0.32,0.33,0.34,0.35,0.36,0.37 -o " + dir);
   INFO(r.output);
   REQUIRE(r.code == 0);
   const auto source = skinmesh::balls_from_molecule(skinmesh::read_molecule(dir + "/source.xyzr"), 0.5);

@@ -18,7 +18,9 @@ using namespace skinmesh;
 
 namespace {
 
-std::vector<Ball> molecule_balls(const char* file, int model = 1) { return test::centred_model(test::data_file(file), model); }
+std::vector<Ball> molecule_balls(const char* file, int model = 1) {
+  return test::centred_model(test::data_file(file), model);
+}
 
 TopologyWindows windows_of(const std::vector<Ball>& source, const std::vector<Ball>& target) {
   const std::vector<BallPair> pairs = live_pairs(source, target);
@@ -28,8 +30,8 @@ TopologyWindows windows_of(const std::vector<Ball>& source, const std::vector<Ba
 }
 
 struct Run {
-  long changes = 0;    // frame to frame, by skin_topology from scratch
-  long carried = 0;    // frames whose count was carried
+  long changes = 0;      // frame to frame, by skin_topology from scratch
+  long carried = 0;      // frames whose count was carried
   long blind_wrong = 0;  // frames a carrier without windows gets wrong
 };
 
@@ -66,9 +68,9 @@ TEST_CASE("blend topology: every change between frames lies in a window, and a c
           "[morph][topology][large]") {
   SECTION("2k39 model 1 -> 3, 201 frames") {
     const Run run = check_frames(molecule_balls("2k39_3models.pdb", 1), molecule_balls("2k39_3models.pdb", 3), 201);
-    CHECK(run.changes >= 5);             // premise: the topology does change between frames
-    CHECK(run.blind_wrong > 0);          // and carrying without the windows would miss it
-    CHECK(run.carried >= 201 / 2);       // most frames carry a count
+    CHECK(run.changes >= 5);        // premise: the topology does change between frames
+    CHECK(run.blind_wrong > 0);     // and carrying without the windows would miss it
+    CHECK(run.carried >= 201 / 2);  // most frames carry a count
   }
   SECTION("pept -> 3al1, 101 frames (many changes)") {
     const Run run = check_frames(molecule_balls("pept.pdb"), molecule_balls("3al1.pdb"), 101);
