@@ -523,8 +523,8 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
     pending = std::move(made);
     checking.run([&] {  // the check, then the frame's files, beside the next frame
       if (!topology)
-        topology.emplace(topology_change_windows(morph.middle_complex(), morph.sizes(), reference.source,
-                                                 reference.target, reference.pairs, reference.oracle));
+        topology.emplace(TopologyWindows(morph.middle_complex(), morph.sizes(), reference.source, reference.target,
+                                         reference.pairs, reference.oracle));
       check = check_blend_frame(pending.frame.mesh, pending.starts, pending.frame.ids, reference, pending.t, min_angle,
                                 history, *topology);
       if (check.holds()) stage_frame(out.outputs, out.dir, pending, out.files);

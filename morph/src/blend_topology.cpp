@@ -2,9 +2,6 @@
 
 #include "skinmesh/core/quadratic.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 
@@ -42,17 +39,6 @@ std::vector<NearRoot> near_roots(const CellSize& q, double tolerance) {
   return found;
 }
 
-// Whether F_t may have a critical point at the cell's centre near `root`:
-// the oracle's gradient there, certified against every pair, is not
-// clearly away from zero. `start`: the cell's pairs.
-bool may_be_critical(const CellSize& q, const NearRoot& root, const std::vector<BallPair>& start,
-                     const MorphOracle& oracle, double gradient_below) {
-  const double t = std::clamp(root.t, 1e-12, 1 - 1e-12);
-  const MorphOracleResult r = oracle.evaluate(q.center(t), t, start);
-  const double reach = gradient_below + 4 * q.center_slope.norm() * root.half_width;  // |grad F| = 2|x - Z l*|
-  return !r.certified || r.gradient.norm() <= reach;
-}
-
 std::vector<BallPair> cell_pairs(const MixedCell& cell, const std::vector<BallPair>& pairs) {
   std::vector<BallPair> own;
   for (int k = 0; k <= cell.dim; ++k) own.push_back(pairs[static_cast<size_t>(cell.balls[static_cast<size_t>(k)])]);
@@ -69,58 +55,75 @@ std::vector<double> sizes_at(const SkinComplex& middle, const std::vector<Ball>&
   return sizes;
 }
 
-void merge(std::vector<std::pair<double, double>>& windows) {
-  std::sort(windows.begin(), windows.end());
-  std::vector<std::pair<double, double>> merged;
-  for (const auto& w : windows) {
-    if (merged.empty() || w.first > merged.back().second) merged.push_back(w);
-    else merged.back().second = std::max(merged.back().second, w.second);
-  }
-  windows = std::move(merged);
-}
-
 }  // namespace
 
-bool TopologyWindows::meets(double a, double b) const {
-  if (a > b) std::swap(a, b);
-  // The first window that ends at or after a; the windows are disjoint and ascending.
-  const auto w = std::lower_bound(windows.begin(), windows.end(), a,
-                                  [](const std::pair<double, double>& x, double t) { return x.second < t; });
-  return w != windows.end() && w->first <= b;
+TopologyWindows::TopologyWindows(const std::vector<std::pair<double, double>>& windows) {
+  for (const auto& [from, to] : windows) candidates_.push_back({from, to, (from + to) / 2, 0, -1, 1});
+  std::sort(candidates_.begin(), candidates_.end(),
+            [](const Candidate& x, const Candidate& y) { return x.from < y.from; });
+  for (const Candidate& c : candidates_) reach_.push_back(reach_.empty() ? c.to : std::max(reach_.back(), c.to));
 }
 
-TopologyWindows topology_change_windows(const SkinComplex& middle, const std::vector<CellSize>& sizes,
-                                        const std::vector<Ball>& source, const std::vector<Ball>& target,
-                                        const std::vector<BallPair>& pairs, const MorphOracle& oracle,
-                                        const TopologyWindowOptions& options) {
+TopologyWindows::TopologyWindows(const SkinComplex& middle, const std::vector<CellSize>& sizes,
+                                 const std::vector<Ball>& source, const std::vector<Ball>& target,
+                                 const std::vector<BallPair>& pairs, const MorphOracle& oracle,
+                                 const TopologyWindowOptions& options)
+    : oracle_(oracle) {
   // Two sizes more than cell_sizes fitted its curves to measure each curve's error.
   const std::vector<double> at_04 = sizes_at(middle, source, target, pairs, 0.4);
   const std::vector<double> at_06 = sizes_at(middle, source, target, pairs, 0.6);
-  TopologyWindows out;
-  std::vector<std::pair<size_t, NearRoot>> roots;  // (cell, root)
   for (size_t c = 0; c < sizes.size(); ++c) {
     const CellSize& q = sizes[c];
     const double error = std::max(std::abs(q.at(0.4) - at_04[c]), std::abs(q.at(0.6) - at_06[c]));
     // An overlay cell's curve is a quadratic whatever its error (which then widens its windows).
     if (!q.overlay_cell && !(error <= options.not_quadratic_above)) continue;
-    ++out.curves;
-    for (const NearRoot& root : near_roots(q, 1e-9 + 10 * error))
-      if (root.t + root.half_width > 0 && root.t - root.half_width < 1) roots.emplace_back(c, root);
-  }
-  out.roots = static_cast<long>(roots.size());
-  std::vector<char> critical(roots.size(), 0);  // an oracle solve each: tens of thousands on a large pair
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k != r.end(); ++k) {
-      const auto& [c, root] = roots[k];
-      const std::vector<BallPair> start = cell_pairs(middle.cells()[c], pairs);
-      critical[k] = may_be_critical(sizes[c], root, start, oracle, options.gradient_below);
+    ++curves_;
+    const int cell = static_cast<int>(cells_.size());
+    bool any = false;
+    for (const NearRoot& root : near_roots(q, 1e-9 + 10 * error)) {
+      if (root.t + root.half_width <= 0 || root.t - root.half_width >= 1) continue;
+      // |grad F| = 2|x - Z l*|: twice what the centre moves within the window, and more.
+      const double below = options.gradient_below + 4 * q.center_slope.norm() * root.half_width;
+      candidates_.push_back({root.t - root.half_width, root.t + root.half_width, root.t, below, cell, -1});
+      any = true;
     }
-  });
-  for (size_t k = 0; k < roots.size(); ++k)
-    if (critical[k]) out.windows.emplace_back(roots[k].second.t - roots[k].second.half_width,
-                                              roots[k].second.t + roots[k].second.half_width);
-  merge(out.windows);
-  return out;
+    if (any) cells_.push_back({q.center_half, q.center_slope, cell_pairs(middle.cells()[c], pairs)});
+  }
+  std::sort(candidates_.begin(), candidates_.end(),
+            [](const Candidate& x, const Candidate& y) { return x.from < y.from; });
+  for (const Candidate& c : candidates_) reach_.push_back(reach_.empty() ? c.to : std::max(reach_.back(), c.to));
+}
+
+// A possible change where the morph oracle's gradient at the cell's centre
+// (certified against every pair) is not clearly away from zero.
+bool TopologyWindows::decide(Candidate& c) const {
+  if (c.possible < 0) {
+    const Cell& cell = cells_[static_cast<size_t>(c.cell)];
+    const double t = std::clamp(c.t, 1e-12, 1 - 1e-12);
+    const MorphOracleResult r = oracle_->evaluate(cell.center_half + (t - 0.5) * cell.center_slope, t, cell.start);
+    c.possible = !r.certified || r.gradient.norm() <= c.gradient_below;
+  }
+  return c.possible == 1;
+}
+
+bool TopologyWindows::meets(double a, double b) {
+  if (a > b) std::swap(a, b);
+  // Candidates whose window starts by b, back from the last, while one of them or an earlier one reaches a.
+  const auto end = std::upper_bound(candidates_.begin(), candidates_.end(), b,
+                                    [](double t, const Candidate& c) { return t < c.from; });
+  for (auto k = end - candidates_.begin(); k-- > 0 && reach_[static_cast<size_t>(k)] >= a;) {
+    Candidate& c = candidates_[static_cast<size_t>(k)];
+    if (c.to >= a && decide(c)) return true;
+  }
+  return false;
+}
+
+long TopologyWindows::decided() const {
+  return std::count_if(candidates_.begin(), candidates_.end(), [](const Candidate& c) { return c.possible >= 0; });
+}
+
+long TopologyWindows::possible() const {
+  return std::count_if(candidates_.begin(), candidates_.end(), [](const Candidate& c) { return c.possible == 1; });
 }
 
 CountedTopology CarriedTopology::at(double t, const std::vector<Ball>& balls) {

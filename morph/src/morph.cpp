@@ -1,5 +1,6 @@
 #include "skinmesh/morph/morph.hpp"
 #include "skinmesh/core/skin_topology.hpp"
+#include "skinmesh/morph/blend_topology.hpp"
 #include "skinmesh/morph/moving_balls.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"  // mesh_topology
 
@@ -24,6 +25,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <utility>
 
 namespace skinmesh {
@@ -119,6 +121,7 @@ struct Morph::Impl {
     long first_new_id = 0, before = 0;  // the first id this frame may give; vertices of the frame before
   };
   void mend_frame(const SkinComplex& next, double t, Transported& moved, const std::function<void()>& before_remesh);
+  SkinTopology count_skin(const SkinComplex& next, double t);
 
   std::vector<Ball> source_, target_;
   std::vector<BallPair> pairs_;
@@ -129,6 +132,10 @@ struct Morph::Impl {
   MorphOptions options_;
   std::vector<CellSize> sizes_;  // per cell of middle_: its size and centre as functions of t
   std::vector<TopologyEvent> events_;
+  // The remeshes' certificate: the skin's topology, carried from one
+  // remesh's count to the next where no change can lie between; made at
+  // the first remesh.
+  std::optional<CarriedTopology> skin_counts_;
   MorphFrame frame_;
   double t_ = 0;
   long next_id_ = 0;
@@ -310,14 +317,16 @@ void Morph::Impl::reseat(const SkinComplex& next, FrameStats& stats) {
 // scratch (counted as a full rebuild). Either mesh is certified: its
 // components, voids and Euler characteristic must be those of the skin of
 // the frame's balls, counted from their weighted alpha complex
-// (skin_topology.hpp) beside the remesh: refinement from transported
-// vertices can close a thin handle that seeds and refinement from scratch
-// keep. Throws Error when the mesh from scratch is not certified either.
+// (skin_topology.hpp), or carried from an earlier remesh's count where no
+// change can lie between (blend_topology.hpp), beside the remesh:
+// refinement from transported vertices can close a thin handle that seeds
+// and refinement from scratch keep. Throws Error when the mesh from scratch
+// is not certified either.
 void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop,
                                     const std::vector<SkinSample>& seeds) {
   SkinTopology skin;
   tbb::task_group counting;
-  counting.run([&] { skin = skin_topology(next.balls()); });
+  counting.run([&] { skin = count_skin(next, frame_.stats.t); });
   const long before = static_cast<long>(frame_.ids.size());
   const std::vector<long> ids = frame_.ids;  // of `moved`'s vertices, for a second remesh
   bool remeshed = repair(next, moved, drop, {});
@@ -346,6 +355,15 @@ void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& 
   if (made != skin)
     throw Error("morph frame at t = " + std::to_string(frame_.stats.t) + ": the mesh has " + made.text() +
                 " where the skin has " + skin.text() + "; the frame is refused");
+}
+
+// The skin topology of `next`, the complex of the frame at t: counted from
+// its balls, or carried from an earlier remesh's count (blend_topology.hpp).
+SkinTopology Morph::Impl::count_skin(const SkinComplex& next, double t) {
+  if (!skin_counts_)
+    skin_counts_.emplace(
+        TopologyWindows(middle_, sizes_, source_, target_, pairs_, MorphOracle(source_, target_, options_.shrink)));
+  return skin_counts_->at(t, next.balls()).topology;
 }
 
 void Morph::Impl::finish_frame(double t, Clock::time_point start) {

@@ -15,7 +15,7 @@
 // against every pair) vanishes at the cell's centre there. A window of
 // time is kept around every root where the gradient is not clearly away
 // from zero, widened by the curve's measured error; any two frames in
-// (0,1) with no window between them have the same topology.
+// (0,1) with no such window between them have the same topology.
 #pragma once
 
 #include "skinmesh/core/balls.hpp"
@@ -25,6 +25,7 @@
 #include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/morph/events.hpp"
 
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -44,21 +45,52 @@ struct TopologyWindowOptions {
   double not_quadratic_above = 1e-4;
 };
 
-struct TopologyWindows {
-  std::vector<std::pair<double, double>> windows;  // [from, to], ascending by from, overlapping ones merged
-  long curves = 0;      // size curves looked at (the others are no quadratic)
-  long roots = 0;       // their roots and near-roots in (0,1)
+// The times at which the skin's topology may change, decided on demand:
+// every root of every size curve is a candidate, and whether it is a
+// possible change (the oracle's gradient at the cell's centre there) is
+// decided the first time an interval holding it is asked about, in any
+// order, until one is. Steps of a fine morph hold a few candidates; a
+// coarse step holds thousands, and a possible change is found among its
+// first hundred or so.
+class TopologyWindows {
+ public:
+  // No candidate: no change anywhere.
+  TopologyWindows() = default;
+  // Windows known to be possible changes, [from, to] each (tests).
+  explicit TopologyWindows(const std::vector<std::pair<double, double>>& windows);
+  // `middle`, `sizes` and `pairs` as for critical_events (the complex of
+  // B(1/2) of the live pairs, its cells' size curves); `source` and
+  // `target` the morph's balls, `oracle` their morph oracle (copied).
+  TopologyWindows(const SkinComplex& middle, const std::vector<CellSize>& sizes, const std::vector<Ball>& source,
+                  const std::vector<Ball>& target, const std::vector<BallPair>& pairs, const MorphOracle& oracle,
+                  const TopologyWindowOptions& options = {});
   // Whether the skin's topology may differ between t = a and t = b (in any order).
-  bool meets(double a, double b) const;
-};
+  bool meets(double a, double b);
+  long curves() const { return curves_; }                                      // size curves looked at
+  long candidates() const { return static_cast<long>(candidates_.size()); }  // their roots and near-roots
+  long decided() const;   // candidates asked about so far
+  long possible() const;  // of them, possible changes
 
-// `middle`, `sizes` and `pairs` as for critical_events (the complex of B(1/2)
-// of the live pairs, its cells' size curves); `source` and `target` the
-// morph's balls, `oracle` their morph oracle.
-TopologyWindows topology_change_windows(const SkinComplex& middle, const std::vector<CellSize>& sizes,
-                                        const std::vector<Ball>& source, const std::vector<Ball>& target,
-                                        const std::vector<BallPair>& pairs, const MorphOracle& oracle,
-                                        const TopologyWindowOptions& options = {});
+ private:
+  struct Candidate {
+    double from = 0, to = 0;    // the window around the root
+    double t = 0;               // the root
+    double gradient_below = 0;  // a possible change below this gradient (Angstrom): the option and the centre's move
+    int cell = -1;              // into cells_
+    signed char possible = -1;  // -1 not decided yet, 0 no change, 1 a possible change
+  };
+  bool decide(Candidate& c) const;
+  std::vector<Candidate> candidates_;  // ascending by from
+  std::vector<double> reach_;          // per candidate: the largest `to` of it and all before it
+  // Per cell with a candidate: its centre's line and its pairs (the solve's start).
+  struct Cell {
+    Eigen::Vector3d center_half = Eigen::Vector3d::Zero(), center_slope = Eigen::Vector3d::Zero();
+    std::vector<BallPair> start;
+  };
+  std::vector<Cell> cells_;
+  std::optional<MorphOracle> oracle_;
+  long curves_ = 0;
+};
 
 // A frame's count: the topology, and the t of the frame whose balls were counted.
 struct CountedTopology {
