@@ -96,7 +96,7 @@ TopologyWindows::TopologyWindows(const SkinComplex& middle, const std::vector<Ce
 
 // A possible change where the morph oracle's gradient at the cell's centre
 // (certified against every pair) is not clearly away from zero.
-bool TopologyWindows::decide(Candidate& c) const {
+bool TopologyWindows::decide(Candidate& c) {
   if (c.possible < 0) {
     const Cell& cell = cells_[static_cast<size_t>(c.cell)];
     const double t = std::clamp(c.t, 1e-12, 1 - 1e-12);

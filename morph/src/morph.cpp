@@ -326,7 +326,8 @@ void Morph::Impl::remesh_or_rebuild(const SkinComplex& next, const SurfaceMesh& 
                                     const std::vector<SkinSample>& seeds) {
   SkinTopology skin;
   tbb::task_group counting;
-  counting.run([&] { skin = count_skin(next, frame_.stats.t); });
+  const double t = frame_.stats.t;  // read here: the remesh writes frame_.stats beside the count
+  counting.run([&] { skin = count_skin(next, t); });
   const long before = static_cast<long>(frame_.ids.size());
   const std::vector<long> ids = frame_.ids;  // of `moved`'s vertices, for a second remesh
   bool remeshed = repair(next, moved, drop, {});

@@ -79,7 +79,7 @@ class TopologyWindows {
     int cell = -1;              // into cells_
     signed char possible = -1;  // -1 not decided yet, 0 no change, 1 a possible change
   };
-  bool decide(Candidate& c) const;
+  bool decide(Candidate& c);  // asks the oracle once, keeps the answer in c
   std::vector<Candidate> candidates_;  // ascending by from
   std::vector<double> reach_;          // per candidate: the largest `to` of it and all before it
   // Per cell with a candidate: its centre's line and its pairs (the solve's start).
