@@ -119,3 +119,119 @@ RepairResult remesh_from_vertices(const SkinComplex& complex, const SurfaceMesh&
 }
 
 }  // namespace skinmesh::detail
+
+namespace skinmesh::detail {
+
+namespace {
+
+// The stars of a mesh's vertices, changed by half-edge contractions.
+class ContractibleStars {
+ public:
+  explicit ContractibleStars(const SurfaceMesh& mesh) : mesh_(mesh), stars_(mesh.vertices.size()), alive_(mesh.triangles.size(), 1) {
+    for (size_t f = 0; f < mesh.triangles.size(); ++f)
+      for (int v : mesh.triangles[f]) stars_[static_cast<size_t>(v)].push_back(static_cast<int>(f));
+  }
+  const std::vector<char>& alive() const { return alive_; }
+  std::vector<int> ring(int v) const {
+    std::vector<int> out;
+    for (int f : stars_[static_cast<size_t>(v)])
+      for (int w : mesh_.triangles[static_cast<size_t>(f)])
+        if (w != v) out.push_back(w);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+  // `gone` merged into `kept` (contract, mesh_part.hpp's conditions); false, nothing changed, where they fail.
+  bool contract(int gone, int kept, SurfaceMesh& mesh) {
+    std::vector<int> shared;  // the triangles on the edge
+    for (int f : stars_[static_cast<size_t>(gone)])
+      if (has(f, kept)) shared.push_back(f);
+    if (shared.size() != 2) return false;
+    const std::vector<int> around_gone = ring(gone), around_kept = ring(kept);
+    if (around_gone.size() < 3 || around_kept.size() < 3 || around_gone.size() + around_kept.size() < 8) return false;
+    std::vector<int> common;
+    std::set_intersection(around_gone.begin(), around_gone.end(), around_kept.begin(), around_kept.end(),
+                          std::back_inserter(common));
+    if (common.size() != 2) return false;
+    for (int c : common)
+      if (stars_[static_cast<size_t>(c)].size() < 4) return false;
+    for (int f : shared) {
+      alive_[static_cast<size_t>(f)] = 0;
+      for (int v : mesh.triangles[static_cast<size_t>(f)]) drop_from_star(v, f);
+    }
+    for (int f : stars_[static_cast<size_t>(gone)]) {
+      std::replace(mesh.triangles[static_cast<size_t>(f)].begin(), mesh.triangles[static_cast<size_t>(f)].end(), gone,
+                   kept);
+      stars_[static_cast<size_t>(kept)].push_back(f);
+    }
+    stars_[static_cast<size_t>(gone)].clear();
+    return true;
+  }
+
+ private:
+  bool has(int f, int v) const {
+    const auto& t = mesh_.triangles[static_cast<size_t>(f)];
+    return t[0] == v || t[1] == v || t[2] == v;
+  }
+  void drop_from_star(int v, int f) {
+    auto& star = stars_[static_cast<size_t>(v)];
+    star.erase(std::remove(star.begin(), star.end(), f), star.end());
+  }
+  const SurfaceMesh& mesh_;  // the mesh being contracted (its triangles change)
+  std::vector<std::vector<int>> stars_;
+  std::vector<char> alive_;
+};
+
+}  // namespace
+
+bool merge_lost_vertices(SurfaceMesh& mesh, std::vector<char>& lost, std::vector<int>& kept_from,
+                         std::vector<char>& touched) {
+  kept_from.clear();
+  touched.clear();
+  SurfaceMesh work = mesh;
+  ContractibleStars stars(work);
+  std::vector<char> left = lost;
+  std::vector<int> pending, merged_into;
+  for (size_t v = 0; v < left.size(); ++v)
+    if (left[v]) pending.push_back(static_cast<int>(v));
+  // A lost vertex whose neighbours are all lost waits for one of them to go.
+  bool progress = true;
+  while (!pending.empty() && progress) {
+    progress = false;
+    std::vector<int> still;
+    for (int v : pending) {
+      std::vector<std::pair<double, int>> nearest;
+      for (int w : stars.ring(v))
+        if (!left[static_cast<size_t>(w)])
+          nearest.emplace_back((work.vertices[static_cast<size_t>(w)] - work.vertices[static_cast<size_t>(v)]).squaredNorm(), w);
+      std::sort(nearest.begin(), nearest.end());
+      bool merged = false;
+      int into = -1;
+      for (const auto& [distance, w] : nearest)
+        if ((merged = stars.contract(v, w, work))) {
+          into = w;
+          break;
+        }
+      if (merged) {
+        merged_into.push_back(into);
+        left[static_cast<size_t>(v)] = 0;
+        progress = true;
+      } else {
+        still.push_back(v);
+      }
+    }
+    pending = std::move(still);
+  }
+  if (!pending.empty()) return false;
+  std::vector<char> changed(work.vertices.size(), 0);  // the merged-into vertices and their neighbours
+  for (int w : merged_into) {
+    changed[static_cast<size_t>(w)] = 1;
+    for (int u : stars.ring(w)) changed[static_cast<size_t>(u)] = 1;
+  }
+  mesh = used_part(work, stars.alive(), kept_from);
+  lost.assign(mesh.vertices.size(), 0);
+  for (int v : kept_from) touched.push_back(changed[static_cast<size_t>(v)]);
+  return true;
+}
+
+}  // namespace skinmesh::detail

@@ -18,6 +18,21 @@ namespace skinmesh::detail {
 // part's vertex k.
 SurfaceMesh used_part(const SurfaceMesh& mesh, const std::vector<char>& keep_triangle, std::vector<int>& kept_from);
 
+// Every vertex marked in `lost` (one transport could not put on the new
+// skin) merged into its nearest neighbour that is not lost, along their
+// edge, where the link condition holds: the two ends share exactly the two
+// neighbours opposite the edge, each keeps three or more neighbours and
+// each opposite corner three or more triangles, so the mesh stays a closed
+// 2-manifold of the same topology. Lost neighbours of a lost vertex are
+// merged first where they can be. The triangles that kept a merged vertex's
+// place are left to be judged (they may fail the frame's criteria). True,
+// with `mesh` renumbered (kept_from[k]: the old index of vertex k), `lost`
+// all zero and `touched` marking per vertex the corners of the triangles
+// that changed, when every lost vertex went; false, with `mesh` and `lost`
+// as they were, otherwise.
+bool merge_lost_vertices(SurfaceMesh& mesh, std::vector<char>& lost, std::vector<int>& kept_from,
+                         std::vector<char>& touched);
+
 // Before a frame is remeshed from its vertices: along every mesh edge
 // shorter than `below` times the smaller target edge length (`criteria`) at
 // its ends, the vertex with the larger index is marked in `drop` (unless

@@ -119,7 +119,9 @@ struct Morph::Impl {
     std::vector<char> handled;        // per event: its vanishing component was dropped (drop_vanished)
     std::vector<int> partner;         // per event: the event of the step it cancels, or -1 (cancelling_partners)
     long first_new_id = 0, before = 0;  // the first id this frame may give; vertices of the frame before
+    long lost_left = 0;               // lost vertices still in `mesh` (merge_lost)
   };
+  void merge_lost(Transported& moved);
   void mend_frame(const SkinComplex& next, double t, Transported& moved, const std::function<void()>& before_remesh);
   SkinTopology count_skin(const SkinComplex& next, double t);
 
@@ -424,6 +426,21 @@ std::vector<char> Morph::Impl::drop_vanished(double t, const std::vector<char>& 
   return handled;
 }
 
+// The vertices transport lost merged into neighbours it placed
+// (merge_lost_vertices), with their ids; the triangles left around them are
+// judged with the rest. When one cannot be merged, the frame keeps its lost
+// vertices (lost_left) and is remeshed whole without them.
+void Morph::Impl::merge_lost(Transported& moved) {
+  std::vector<int> kept_from;
+  std::vector<char> touched;  // every triangle is judged after transport: not needed here
+  if (!detail::merge_lost_vertices(moved.mesh, moved.drop, kept_from, touched)) return;
+  std::vector<long> ids;
+  ids.reserve(kept_from.size());
+  for (int v : kept_from) ids.push_back(frame_.ids[static_cast<size_t>(v)]);
+  frame_.ids = std::move(ids);
+  moved.lost_left = 0;
+}
+
 // Whether a component or void vanishes in (t_, t] that drop_vanished did
 // not drop (`handled`) and that was not born in the step itself
 // (`partner`): the frame is then remeshed whole.
@@ -464,9 +481,11 @@ const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
   moved.drop = move_vertices(next, moved.mesh, stats, stayed);
   moved.handled = drop_vanished(t, stayed, moved.mesh, moved.drop, stats);
   moved.partner = cancelling_partners(events_, sizes_, t_, t, moved.handled);  // voids born and gone in the step
+  moved.lost_left = std::count(moved.drop.begin(), moved.drop.end(), 1);
+  if (moved.lost_left > 0) merge_lost(moved);
   stats.seconds_transport = seconds_since(stage_start);
   // Too dense to be worth mending (a skin that shrank under it): afresh.
-  if (stats.lost == 0 && too_dense(next, moved.mesh)) {
+  if (moved.lost_left == 0 && too_dense(next, moved.mesh)) {
     frame_.stats = stats;
     rebuild_thinned(next, t);
     std::swap(current_, spare_);
@@ -474,7 +493,7 @@ const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
     finish_frame(t, start);
     return frame_;
   }
-  if (stats.lost == 0) {
+  if (moved.lost_left == 0) {
     stage_start = Clock::now();
     if (options_.relaxation.passes > 0) relax_tangentially(next, moved.mesh, options_.relaxation);
     stats.seconds_relax = seconds_since(stage_start);
@@ -490,7 +509,7 @@ const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
   // remesh, which runs partly on both cores: overlapping that too saved
   // little and raised the peak memory (glibc's heap for the other thread).
   // The cell list and balls are made on this thread for the same reason.
-  const bool ahead = next_t > t && next_t < 1 && stats.lost == 0 && !vanishing_left(t, moved.handled, moved.partner);
+  const bool ahead = next_t > t && next_t < 1 && moved.lost_left == 0 && !vanishing_left(t, moved.handled, moved.partner);
   std::vector<SkinComplex::KnownCell> known;
   std::vector<Ball> balls;
   tbb::task_group lookahead;  // after what its task reads: if the repair throws, it waits before they go
@@ -524,7 +543,7 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
   detail::LocalRepairOptions local;
   local.crowded_below = options_.repair.crowded_below;
   local.policy = options_.repair.patch;
-  const bool mendable = stats.lost == 0 && add_topology_changes(events_, sizes_, t_, t, moved.handled, moved.partner, local);
+  const bool mendable = moved.lost_left == 0 && add_topology_changes(events_, sizes_, t_, t, moved.handled, moved.partner, local);
   long left = stats.bad_triangles;
   if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop);
   if (mendable && local.changes.empty() && left == 0) {
@@ -534,8 +553,9 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
     const double share = std::max(options_.repair.patch.max_failing_share * static_cast<double>(moved.failing.size()),
                                    static_cast<double>(options_.repair.patch.always_patch_up_to));
     const bool small = left <= share;
-    if (stats.lost > 0)
-      frame_.stats.remeshed_because = std::to_string(stats.lost) + " vertices could not be put on the new skin";
+    if (moved.lost_left > 0)
+      frame_.stats.remeshed_because = std::to_string(moved.lost_left) +
+                                      " vertices could not be put on the new skin nor merged into a neighbour";
     else if (!mendable)
       frame_.stats.remeshed_because = "a component or void vanished that is not a component of its own in the frame before";
     else if (!small)

@@ -638,6 +638,8 @@ struct MovingBalls::Impl {
                            Settled settled, detail::LocalRepairOptions& local);
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
                      SurfaceMesh& moved, std::vector<char>& lost, Settled& settled, long& euler_change);
+  bool merge_lost(SurfaceMesh& moved, std::vector<char>& lost, Settled& settled);
+  void keep_vertices(const std::vector<int>& kept_from, std::vector<char>& lost, Settled& settled);
   bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria,
               const std::vector<SkinSample>& seeds);
   MeshingOptions repair_criteria() const { return options_.frames; }
@@ -1046,7 +1048,8 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
       local.changes.push_back(change);
     }
   const long lost_count = std::count(lost.begin(), lost.end(), 1);
-  if (lost_count > 0) return std::to_string(lost_count) + " vertices could not be put on the new skin";
+  if (lost_count > 0 && !merge_lost(moved, lost, settled))
+    return std::to_string(lost_count) + " vertices could not be put on the new skin nor merged into a neighbour";
   std::vector<char> failing = judge_and_relax(next, moved, settled);
   build_ahead();
   long left = std::count(failing.begin(), failing.end(), 1);
@@ -1103,6 +1106,28 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
   for (size_t f = 0; f < keep.size(); ++f) keep[f] = !gone[static_cast<size_t>(moved.triangles[f][0])];
   std::vector<int> kept_from;
   moved = detail::used_part(moved, keep, kept_from);
+  keep_vertices(kept_from, lost, settled);
+  euler_change += 2 * static_cast<long>(vanished.size());
+  return true;
+}
+
+// The vertices transport lost merged into neighbours it placed
+// (merge_lost_vertices), with their ids; the corners of the triangles the
+// merges changed are no longer settled or carried (their triangles are
+// judged). False, nothing changed, when one cannot be merged.
+bool MovingBalls::Impl::merge_lost(SurfaceMesh& moved, std::vector<char>& lost, Settled& settled) {
+  std::vector<int> kept_from;
+  std::vector<char> touched;
+  std::vector<char> merged = lost;
+  if (!detail::merge_lost_vertices(moved, merged, kept_from, touched)) return false;
+  keep_vertices(kept_from, lost, settled);
+  for (size_t v = 0; v < touched.size(); ++v)
+    if (touched[v]) settled.verdict.settled[v] = settled.verdict.carried[v] = settled.thinning[v] = 0;
+  return true;
+}
+
+// The ids and per-vertex marks of the vertices `kept_from` names, in its order.
+void MovingBalls::Impl::keep_vertices(const std::vector<int>& kept_from, std::vector<char>& lost, Settled& settled) {
   std::vector<long> ids;
   for (int v : kept_from) ids.push_back(frame_.ids[static_cast<size_t>(v)]);
   frame_.ids = std::move(ids);
@@ -1116,8 +1141,6 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
     for (int v : kept_from) before.push_back(settled.verdict.before[static_cast<size_t>(v)]);
     settled.verdict.before = std::move(before);
   }
-  euler_change += 2 * static_cast<long>(vanished.size());
-  return true;
 }
 
 namespace detail {

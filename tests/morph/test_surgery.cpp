@@ -12,8 +12,10 @@
 #include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
 #include "skinmesh/quality/guarantees.hpp"
+#include "skinmesh/quality/mesh_quality.hpp"
 #include "judge.hpp"
 #include "local_repair.hpp"
+#include "mesh_part.hpp"
 #include "surgery.hpp"
 #include "vanishing.hpp"
 
@@ -21,6 +23,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <set>
 
 using namespace skinmesh;
 
@@ -493,5 +496,74 @@ TEST_CASE("a vanishing sphere takes the one sphere component wholly within its r
     std::vector<int> both = first_small;
     for (int v = small + 6; v < small + 12; ++v) both.push_back(v);
     CHECK(marked(drop) == both);
+  }
+}
+
+TEST_CASE("lost vertices: each merged into a neighbour, the mesh a closed oriented manifold of the same topology",
+          "[morph]") {
+  const PeptFrame f = pept_frame();
+  const SurfaceMesh& mesh = f.mesh;
+  const size_t n = mesh.vertices.size();
+  // Scattered lost vertices, and one with its whole ring lost (whose
+  // neighbours must go first, into vertices that are not lost).
+  std::vector<char> lost(n, 0);
+  for (size_t v = 7; v < n; v += n / 9) lost[v] = 1;
+  const int centre = static_cast<int>(n / 2);
+  lost[static_cast<size_t>(centre)] = 1;
+  for (const auto& t : mesh.triangles)
+    if (std::find(t.begin(), t.end(), centre) != t.end())
+      for (int v : t) lost[static_cast<size_t>(v)] = 1;
+  const long marked = std::count(lost.begin(), lost.end(), 1);
+  REQUIRE(marked > 12);
+
+  SurfaceMesh merged = mesh;
+  std::vector<char> marks = lost;
+  std::vector<int> kept_from;
+  std::vector<char> touched;
+  REQUIRE(detail::merge_lost_vertices(merged, marks, kept_from, touched));
+  CHECK(std::count(marks.begin(), marks.end(), 1) == 0);
+  REQUIRE(merged.vertices.size() == n - static_cast<size_t>(marked));
+  CHECK(merged.triangles.size() == mesh.triangles.size() - 2 * static_cast<size_t>(marked));
+  REQUIRE(kept_from.size() == merged.vertices.size());
+  REQUIRE(touched.size() == merged.vertices.size());
+  for (size_t k = 0; k < kept_from.size(); ++k) {
+    REQUIRE(!lost[static_cast<size_t>(kept_from[k])]);
+    CHECK(merged.vertices[k] == mesh.vertices[static_cast<size_t>(kept_from[k])]);  // nothing moved
+  }
+  const MeshQuality before = grade_mesh(mesh), after = grade_mesh(merged);
+  CHECK((after.closed && after.manifold && after.oriented));
+  CHECK(mesh_topology(merged) == mesh_topology(mesh));
+  CHECK(after.euler == before.euler);
+  // A triangle that is not one of the mesh's own (by its corners' old
+  // numbers) has every corner marked touched.
+  std::set<std::array<int, 3>> own;
+  for (auto t : mesh.triangles) {
+    std::sort(t.begin(), t.end());
+    own.insert(t);
+  }
+  long changed = 0;
+  for (const auto& t : merged.triangles) {
+    std::array<int, 3> old{kept_from[static_cast<size_t>(t[0])], kept_from[static_cast<size_t>(t[1])],
+                           kept_from[static_cast<size_t>(t[2])]};
+    std::sort(old.begin(), old.end());
+    if (own.count(old)) continue;
+    ++changed;
+    for (int v : t) CHECK(touched[static_cast<size_t>(v)]);
+  }
+  CHECK(changed >= marked);
+
+  SECTION("a vertex whose merge would break the link condition everywhere stays: false, nothing changed") {
+    // A tetrahedron: every contraction leaves two triangles on three points.
+    SurfaceMesh tetrahedron;
+    tetrahedron.vertices = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                            Eigen::Vector3d(0, 0, 1)};
+    tetrahedron.cells = {0, 0, 0, 0};
+    tetrahedron.normals.assign(4, Eigen::Vector3d::UnitZ());
+    tetrahedron.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    const SurfaceMesh given = tetrahedron;
+    std::vector<char> one_lost{1, 0, 0, 0};
+    CHECK_FALSE(detail::merge_lost_vertices(tetrahedron, one_lost, kept_from, touched));
+    CHECK(tetrahedron.triangles == given.triangles);
+    CHECK(one_lost == std::vector<char>{1, 0, 0, 0});
   }
 }
