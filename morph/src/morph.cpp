@@ -46,22 +46,24 @@ bool takes_a_sphere(const TopologyEvent& e) { return (e.dim == 0 || e.dim == 3) 
 // (down by 2) and was `handled` (its component dropped, drop_vanished) is
 // left out; one that cancels an event of the same step (`partner`,
 // cancelling_partners) is a place with its partner, adding nothing to the
-// Euler characteristic. False when one vanishes that was neither: the
-// frame is remeshed whole. (Such an event as a patch to remesh, like a
-// neck, made the morph slower, the patches failing after their cost.) The
-// patch reaches 1 A plus twice the feature's size at `to` from the event's
-// apex, past the vertices transport left around it.
-bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
+// Euler characteristic. One that vanishes and was neither (the frame
+// before does not hold it as a component of its own: a neck to it pinched
+// in the same step) is a place whose patch must take it away. The patch
+// reaches 1 A plus twice the feature's size from the event's apex at `to`,
+// past the vertices transport left around it: the size at `to` for a
+// feature that opens or is born, at `from` for one that vanishes (its size
+// at `to` is about nothing).
+void add_topology_changes(const std::vector<TopologyEvent>& events, const std::vector<CellSize>& sizes, double from,
                           double to, const std::vector<char>& handled, const std::vector<int>& partner,
                           detail::LocalRepairOptions& local) {
   for (size_t i = 0; i < events.size(); ++i) {
     const TopologyEvent& e = events[i];
     if (!in_step(e, from, to) || handled[i]) continue;
     const bool cancelled = partner[i] >= 0;
-    if (takes_a_sphere(e) && !cancelled) return false;
+    const bool vanishing = takes_a_sphere(e) && !cancelled;
     const bool sphere = e.dim == 0 || e.dim == 3;
     const CellSize& size = sizes[static_cast<size_t>(e.cell)];
-    const double feature = std::sqrt(std::abs(size.at(to)));
+    const double feature = std::sqrt(std::abs(size.at(vanishing ? from : to)));
     detail::TopologyChange change;
     change.point = size.center(to);
     change.radius = 1.0 + 2 * feature;
@@ -71,7 +73,6 @@ bool add_topology_changes(const std::vector<TopologyEvent>& events, const std::v
     local.changes.push_back(change);
     if (!cancelled) local.euler_change += e.euler_change;
   }
-  return true;
 }
 
 MeshingOptions with_size_margin(MeshingOptions o, double margin) {
@@ -110,7 +111,6 @@ struct Morph::Impl {
   void overlay_at(double t, SkinComplex& out) const;  // into out's storage (see with_balls)
   std::vector<SkinComplex::KnownCell> known_cells(double t) const;  // the overlay cells' centres and sizes at t
   void finish_frame(double t, Clock::time_point start);
-  bool vanishing_left(double t, const std::vector<char>& handled, const std::vector<int>& partner) const;
   // A frame after transport, relaxation and judging, before its repair.
   struct Transported {
     SurfaceMesh mesh;
@@ -441,17 +441,6 @@ void Morph::Impl::merge_lost(Transported& moved) {
   moved.lost_left = 0;
 }
 
-// Whether a component or void vanishes in (t_, t] that drop_vanished did
-// not drop (`handled`) and that was not born in the step itself
-// (`partner`): the frame is then remeshed whole.
-bool Morph::Impl::vanishing_left(double t, const std::vector<char>& handled, const std::vector<int>& partner) const {
-  for (size_t i = 0; i < events_.size(); ++i) {
-    const TopologyEvent& e = events_[i];
-    if (in_step(e, t_, t) && takes_a_sphere(e) && !handled[i] && partner[i] < 0) return true;
-  }
-  return false;
-}
-
 const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
   if (!(t > t_ && t <= 1)) contract_error("advance_to: t must lie after the current frame and at most 1");
   const auto start = Clock::now();
@@ -509,7 +498,7 @@ const MorphFrame& Morph::Impl::advance_to(double t, double next_t) {
   // remesh, which runs partly on both cores: overlapping that too saved
   // little and raised the peak memory (glibc's heap for the other thread).
   // The cell list and balls are made on this thread for the same reason.
-  const bool ahead = next_t > t && next_t < 1 && moved.lost_left == 0 && !vanishing_left(t, moved.handled, moved.partner);
+  const bool ahead = next_t > t && next_t < 1 && moved.lost_left == 0;
   std::vector<SkinComplex::KnownCell> known;
   std::vector<Ball> balls;
   tbb::task_group lookahead;  // after what its task reads: if the repair throws, it waits before they go
@@ -537,13 +526,13 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
     return;
   }
   const auto repair_start = Clock::now();
-  // Edits and local repair are for frames without lost vertices or a
-  // vanishing component or void left in the mesh; the others are
-  // remeshed whole.
+  // Edits and local repair are for frames without lost vertices left in
+  // the mesh (merge_lost); the others are remeshed whole.
   detail::LocalRepairOptions local;
   local.crowded_below = options_.repair.crowded_below;
   local.policy = options_.repair.patch;
-  const bool mendable = moved.lost_left == 0 && add_topology_changes(events_, sizes_, t_, t, moved.handled, moved.partner, local);
+  add_topology_changes(events_, sizes_, t_, t, moved.handled, moved.partner, local);
+  const bool mendable = moved.lost_left == 0;
   long left = stats.bad_triangles;
   if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop);
   if (mendable && local.changes.empty() && left == 0) {
@@ -556,8 +545,6 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
     if (moved.lost_left > 0)
       frame_.stats.remeshed_because = std::to_string(moved.lost_left) +
                                       " vertices could not be put on the new skin nor merged into a neighbour";
-    else if (!mendable)
-      frame_.stats.remeshed_because = "a component or void vanished that is not a component of its own in the frame before";
     else if (!small)
       frame_.stats.remeshed_because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
                                       std::to_string(static_cast<long>(share)) + ")";
