@@ -69,16 +69,14 @@ struct MorphOptions {
   double max_over_fresh = 3.0;
   double density_screen = 4.0;
   // Every threshold of the repair: crowding, the edits, the local patch
-  // (repair_policy.hpp). The blend patches frames with up to 5% of their
-  // triangles failing after the edits (at least 200): its pairs in 101
-  // frames (t = k/102) remeshed 2, 0 and 2 frames whole (pept -> 3al1, 3al1 ->
-  // 1ubi, 1ubi -> 1hpv) against 31, 49 and 65 with 1%, their frames taking
-  // 0-12% longer; at 2% or at least 2,000, 0, 1 and 18, but the default
-  // 21 frames of pept -> 3al1 (steps of 0.05, 2,000 of 12,000 triangles
-  // failing) took 40% longer than with 1%, where 5% took 3-7% longer.
+  // (repair_policy.hpp). The blend patches frames with up to 2% of their
+  // triangles failing after the edits (at least 200): between different
+  // molecules that remeshes about half as many frames whole as 1% at the
+  // same cost a frame, where a larger share makes its patches cost more
+  // than the remeshes they replace (docs/morph.md, "What is not there yet").
   RepairPolicy repair = [] {
     RepairPolicy r;
-    r.patch.max_failing_share = 0.05;  // a share, 0-1
+    r.patch.max_failing_share = 0.02;  // a share, 0-1
     return r;
   }();
   // Repairs (local and whole-frame) may refine to stricter criteria than

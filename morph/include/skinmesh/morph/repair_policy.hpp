@@ -44,7 +44,7 @@ struct PatchPolicy {
   // the edits (a share, 0-1; 0, with always_patch_up_to 0: never); past it
   // the patches cover much of the mesh and remeshing the whole frame from
   // its vertices is faster. Moving atoms take these defaults; the blend
-  // takes a share of 0.05 (MorphOptions::repair).
+  // takes a share of 0.02 (MorphOptions::repair).
   double max_failing_share = 0.01;
   // ... or at most this many triangles, whatever the share (a count; 0:
   // the share alone). On a small frame the share is a few dozen triangles,
