@@ -72,7 +72,7 @@ void add_mesh_options(CLI::App& cmd, MeshCommandOptions& o) {
       ->required();
   cmd.add_option("--colour,--color", o.colour, colouring_help())
       ->check(CLI::IsMember(colouring_names()))->capture_default_str();
-  cmd.add_flag("--ascii", o.ascii, "write a PLY as text (PyMOL 2.5 opens text PLY only)");
+  cmd.add_flag("--ascii", o.ascii, "write a PLY or VTP as text (PyMOL 2.5 opens text PLY only)");
   cmd.add_flag("--outer-only", o.outer_only,
                "keep only the outer surface: drop every component another encloses (cavities, and anything inside "
                "them), as a boundary-element solver of the exterior wants");
@@ -171,7 +171,8 @@ ExitCode run_mesh(const MeshCommandOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && !global.json;
   const auto start = Clock::now();
   const MeshFormat format = mesh_format_from_path(o.output);
-  if (o.ascii && format != MeshFormat::ply) contract_error("--ascii: only a PLY has a text form to choose (" + o.output + ")");
+  if (o.ascii && format != MeshFormat::ply && format != MeshFormat::vtp)
+    contract_error("--ascii: only a PLY or VTP has a text form to choose (" + o.output + ")");
   check_writable(output_paths(o, format));
   const Molecule m = read_molecule(o.molecule.path, o.molecule.read);
   if (progress)

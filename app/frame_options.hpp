@@ -15,7 +15,7 @@ inline void add_frame_file_options(CLI::App& cmd, FrameFileOptions& o) {
                  "mesh formats, comma-separated: ply vtp off obj stl (a file per frame; frames.pvd needs vtp) and "
                  "glb (every frame in one frames.glb, played by its animation)")
       ->delimiter(',')->check(CLI::IsMember({"ply", "vtp", "off", "obj", "stl", "glb"}))->capture_default_str();
-  cmd.add_flag("--ascii", o.ascii, "write the PLY frames as text (PyMOL 2.5 opens text PLY only)");
+  cmd.add_flag("--ascii", o.ascii, "write the PLY and VTP frames as text (PyMOL 2.5 opens text PLY only)");
   cmd.add_option("--colour,--color", o.colour, colouring_help())
       ->check(CLI::IsMember(colouring_names()))->capture_default_str();
 }

@@ -97,7 +97,8 @@ std::string frame_name(size_t k, const std::string& format) {
 FrameFiles::FrameFiles(const FrameFileOptions& o, const Molecule& source, const Molecule& target)
     : options(o), colouring(colouring_from_name(o.colour)) {
   check_formats(o.formats);
-  if (o.ascii && !wants("ply")) contract_error("--ascii: only PLY frames have a text form to choose; add ply to --format");
+  if (o.ascii && !wants("ply") && !wants("vtp"))
+    contract_error("--ascii: only PLY and VTP frames have a text form to choose; add ply or vtp to --format");
   source_colours = atom_colours(colouring, source.atoms);
   target_colours = atom_colours(colouring, target.atoms);
 }

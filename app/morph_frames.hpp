@@ -56,7 +56,7 @@ void check_formats(const std::vector<std::string>& formats);
 // but glb: every frame in one frames.glb), PLY as text, the colours.
 struct FrameFileOptions {
   std::vector<std::string> formats{"ply", "vtp"};
-  bool ascii = false;            // PLY as text, for PyMOL 2.5
+  bool ascii = false;            // PLY and VTP as text (PyMOL 2.5 reads text PLY only)
   std::string colour = "patch";  // vertex_colours.hpp
 };
 

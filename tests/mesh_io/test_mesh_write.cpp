@@ -8,7 +8,10 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <stdexcept>
 #include <iterator>
 #include <sstream>
 
@@ -219,8 +222,11 @@ TEST_CASE("meshes many times the writers' chunks read back exactly", "[io]") {
       for (size_t v = 0; v < m.vertices.size(); ++v) differ += back.vertices[v] != m.vertices[v];
       CHECK(differ == 0);
     }
+  // VTP as text: the points one a line, in order.
+  MeshWriteOptions text_options;
+  text_options.ascii = true;
   std::ostringstream out;
-  write_mesh(out, m, MeshFormat::vtp, &attributes);
+  write_mesh(out, m, MeshFormat::vtp, &attributes, text_options);
   const std::string text = out.str();
   const std::string opening = "NumberOfComponents=\"3\" format=\"ascii\">\n";
   const size_t first = text.find(opening);
@@ -232,4 +238,102 @@ TEST_CASE("meshes many times the writers' chunks read back exactly", "[io]") {
   CHECK(read == static_cast<long>(m.vertices.size()));
   CHECK(differ == 0);
   CHECK(text.size() > 16 * 65536);
+}
+
+namespace {
+
+// RFC 4648 base64 decoded; throws on a character outside the alphabet.
+std::string from_base64(const std::string& code) {
+  const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string bytes;
+  unsigned bits = 0;
+  int held = 0;
+  for (char c : code) {
+    if (c == '=' || c == '\n') continue;
+    const size_t k = alphabet.find(c);
+    if (k == std::string::npos) throw std::runtime_error(std::string("not base64: ") + c);
+    bits = (bits << 6) | static_cast<unsigned>(k);
+    held += 6;
+    if (held >= 8) {
+      held -= 8;
+      bytes.push_back(static_cast<char>((bits >> held) & 0xff));
+    }
+  }
+  return bytes;
+}
+
+// The values of the binary data array named `name` ("" for the points) of
+// a VTP file, as the VTK XML format lays them out: base64 of a UInt64 byte
+// count followed by the values; checks the array's type name and count.
+template <class T>
+std::vector<T> vtp_array(const std::string& file, const std::string& name, const std::string& type) {
+  const std::string named = name.empty() ? "" : " Name=\"" + name + "\"";
+  const std::string opening = "<DataArray type=\"" + type + "\"" + named;
+  const size_t at = file.find(opening);
+  if (at == std::string::npos) throw std::runtime_error("no array " + opening);
+  const size_t begin = file.find(">\n", at) + 2, end = file.find("</DataArray>", begin);
+  const std::string bytes = from_base64(file.substr(begin, end - begin));
+  uint64_t count = 0;
+  std::memcpy(&count, bytes.data(), sizeof count);
+  if (count != bytes.size() - sizeof count || count % sizeof(T) != 0) throw std::runtime_error("byte count of " + name);
+  std::vector<T> values(count / sizeof(T));
+  std::memcpy(values.data(), bytes.data() + sizeof count, count);
+  return values;
+}
+
+}  // namespace
+
+// The binary VTP read back value for value: points, normals, the vertex
+// properties in their types, the triangles and their offsets.
+TEST_CASE("a binary VTP holds the mesh's values exactly", "[io]") {
+  const SurfaceMesh m = torus(40);
+  VertexAttributes attributes;
+  std::vector<int> small, big;
+  for (size_t v = 0; v < m.vertices.size(); ++v) {
+    attributes.patch.push_back(static_cast<int>(v % 4));
+    attributes.atom.push_back(static_cast<int>(v % 1000) - 3);
+    small.push_back(static_cast<int>(v % 256));
+    big.push_back(static_cast<int>(v * 7919));
+  }
+  attributes.more = {{"flag", PropertyType::uint8, small}, {"serial", PropertyType::uint32, big}};
+  for (const bool single : {false, true}) {
+    INFO((single ? "single" : "double") << " precision");
+    MeshWriteOptions options;
+    options.single_precision = single;
+    std::ostringstream out;
+    write_mesh(out, m, MeshFormat::vtp, &attributes, options);
+    const std::string file = out.str();
+    CHECK(file.find("format=\"ascii\"") == std::string::npos);
+    CHECK(file.find("header_type=\"UInt64\"") != std::string::npos);
+    const auto reals = [&](const std::string& name) {
+      std::vector<double> values;
+      if (single)
+        for (float x : vtp_array<float>(file, name, "Float32")) values.push_back(x);
+      else
+        values = vtp_array<double>(file, name, "Float64");
+      return values;
+    };
+    for (const auto& [name, expected] : {std::pair{std::string(), &m.vertices}, std::pair{std::string("Normals"), &m.normals}}) {
+      const std::vector<double> values = reals(name);
+      REQUIRE(values.size() == 3 * expected->size());
+      long differ = 0;
+      for (size_t v = 0; v < expected->size(); ++v)
+        for (int k = 0; k < 3; ++k) {
+          const double want = single ? static_cast<float>((*expected)[v][k]) : (*expected)[v][k];
+          differ += values[3 * v + static_cast<size_t>(k)] != want;
+        }
+      CHECK(differ == 0);
+    }
+    CHECK(vtp_array<int32_t>(file, "patch", "Int32") == std::vector<int32_t>(attributes.patch.begin(), attributes.patch.end()));
+    CHECK(vtp_array<int32_t>(file, "atom", "Int32") == std::vector<int32_t>(attributes.atom.begin(), attributes.atom.end()));
+    CHECK(vtp_array<uint8_t>(file, "flag", "UInt8") == std::vector<uint8_t>(small.begin(), small.end()));
+    CHECK(vtp_array<uint32_t>(file, "serial", "UInt32") == std::vector<uint32_t>(big.begin(), big.end()));
+    std::vector<int32_t> corners, offsets;
+    for (size_t f = 0; f < m.triangles.size(); ++f) {
+      for (int v : m.triangles[f]) corners.push_back(v);
+      offsets.push_back(static_cast<int32_t>(3 * (f + 1)));
+    }
+    CHECK(vtp_array<int32_t>(file, "connectivity", "Int32") == corners);
+    CHECK(vtp_array<int32_t>(file, "offsets", "Int32") == offsets);
+  }
 }

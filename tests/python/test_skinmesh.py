@@ -3,6 +3,7 @@
 Run by ctest (python_module) with PYTHONPATH at build/python, or by hand:
     PYTHONPATH=build/python /usr/bin/python3 -m pytest tests/python
 """
+import base64
 import json
 import os
 import subprocess
@@ -177,10 +178,22 @@ def test_meshio_reads_every_frame_format_with_unsigned_atoms():
             arrays = {a.get("Name"): a for a in ET.parse(os.path.join(out, f"frame_000{k}.vtp")).iter("DataArray")}
             for name in ("atomid", "source_atom", "target_atom"):
                 assert arrays[name].get("type") == "UInt32", name
-            values = np.array(arrays["atomid"].text.split(), dtype=np.int64)
+            values = vtp_binary_array(arrays["atomid"])
             assert len(values) == len(ply.points) and values.min() >= 0
             assert np.array_equal(values, ply.point_data["atomid"])
-            assert not np.array(arrays[missing].text.split(), dtype=np.int64).any()
+            assert not vtp_binary_array(arrays[missing]).any()
+            assert np.array_equal(vtp_binary_array(arrays[None]).reshape(-1, 3), ply.points)
+            assert np.array_equal(vtp_binary_array(arrays["connectivity"]).reshape(-1, 3), ply.cells_dict["triangle"])
+
+
+def vtp_binary_array(element):
+    """A VTK XML data array of format binary: base64 of a UInt64 byte count, then the values (little endian)."""
+    types = {"Float64": "<f8", "Float32": "<f4", "Int64": "<i8", "Int32": "<i4", "UInt32": "<u4", "UInt8": "u1"}
+    assert element.get("format") == "binary"
+    raw = base64.b64decode(element.text.strip())
+    count = int(np.frombuffer(raw[:8], dtype="<u8")[0])
+    assert count == len(raw) - 8
+    return np.frombuffer(raw[8:], dtype=types[element.get("type")])
 
 
 def test_meshio_writes_what_the_module_returns():

@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -127,11 +128,6 @@ bool has_colours(const VertexAttributes* a, const SurfaceMesh& mesh) {
 const char* ply_type(PropertyType t) {
   return t == PropertyType::uint8 ? "uchar" : t == PropertyType::uint32 ? "uint" : "int";
 }
-
-const char* vtk_type(PropertyType t) {
-  return t == PropertyType::uint8 ? "UInt8" : t == PropertyType::uint32 ? "UInt32" : "Int32";
-}
-
 
 void write_ply_header(std::ostream& out, const SurfaceMesh& mesh, const VertexAttributes* attributes,
                       const MeshWriteOptions& options) {
@@ -280,40 +276,144 @@ void write_stl(std::ostream& out, const SurfaceMesh& mesh) {
   sink.flush();
 }
 
-// VTK XML PolyData, ASCII: opens in ParaView with normals and attributes.
+// Base64 (RFC 4648) into a Sink, three bytes to four characters, with '='
+// padding at the end.
+class Base64 {
+ public:
+  explicit Base64(Sink& out) : out_(out) {}
+  void bytes(const void* data, size_t size) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < size; ++i) {
+      group_[held_++] = b[i];
+      if (held_ == 3) emit();
+    }
+  }
+  template <class T>
+  void value(T v) {
+    bytes(&v, sizeof v);
+  }
+  void finish() {
+    if (held_ > 0) emit();
+  }
+
+ private:
+  void emit() {
+    static const char* const kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    for (size_t k = held_; k < 3; ++k) group_[k] = 0;
+    const unsigned w = (unsigned{group_[0]} << 16) | (unsigned{group_[1]} << 8) | unsigned{group_[2]};
+    const char text[4] = {kAlphabet[(w >> 18) & 63], kAlphabet[(w >> 12) & 63],
+                          held_ > 1 ? kAlphabet[(w >> 6) & 63] : '=', held_ > 2 ? kAlphabet[w & 63] : '='};
+    out_.text(text, 4);
+    held_ = 0;
+  }
+  Sink& out_;
+  unsigned char group_[3] = {0, 0, 0};
+  size_t held_ = 0;
+};
+
+// One VTK XML data array: `count` values of `type` (a VTK type name) that
+// `each(put)` hands over in order, put(value) with value of the type's C++
+// type. Binary: base64 of a UInt64 byte count followed by the values, one
+// stream (the layout VTK's reader expects of uncompressed inline data,
+// header_type UInt64); text: one value a line, or three with `components` 3.
+struct VtpArrays {
+  Sink& out;
+  bool ascii;
+  int digits;
+
+  template <class T, class Each>
+  void array(const char* type, const std::string& name, int components, size_t count, Each each) {
+    out << "<DataArray type=\"" << type << "\"";
+    if (!name.empty()) out << " Name=\"" << name << "\"";
+    if (components > 1) out << " NumberOfComponents=\"" << static_cast<long long>(components) << "\"";
+    out << " format=\"" << (ascii ? "ascii" : "binary") << "\">\n";
+    if (ascii) {
+      size_t k = 0;
+      each([&](T v) {
+        if constexpr (std::is_floating_point_v<T>)
+          out << Real{static_cast<double>(v), digits};
+        else
+          out << Integer{static_cast<long long>(v)};
+        out << (++k % static_cast<size_t>(components) == 0 ? '\n' : ' ');
+      });
+    } else {
+      Base64 code(out);
+      code.value(static_cast<uint64_t>(count * sizeof(T)));
+      each([&](T v) { code.value(v); });
+      code.finish();
+      out << '\n';
+    }
+    out << "</DataArray>\n";
+  }
+
+  // The vertices' points or normals, as doubles or floats.
+  void reals3(const std::string& name, const std::vector<Eigen::Vector3d>& values, bool single) {
+    const auto each = [&](auto put) {
+      for (const auto& v : values)
+        for (int k = 0; k < 3; ++k) put(v[k]);
+    };
+    if (single && !ascii)
+      array<float>("Float32", name, 3, 3 * values.size(),
+                   [&](auto put) { each([&](double x) { put(static_cast<float>(x)); }); });
+    else  // text rounds the doubles to `digits` itself
+      array<double>(single ? "Float32" : "Float64", name, 3, 3 * values.size(), each);
+  }
+
+  void integers(PropertyType type, const std::string& name, const std::vector<int>& values) {
+    const auto each = [&](auto put) {
+      for (int v : values) put(v);
+    };
+    if (type == PropertyType::uint8)
+      array<uint8_t>("UInt8", name, 1, values.size(), [&](auto put) { each([&](int v) { put(static_cast<uint8_t>(v)); }); });
+    else if (type == PropertyType::uint32)
+      array<uint32_t>("UInt32", name, 1, values.size(), [&](auto put) { each([&](int v) { put(static_cast<uint32_t>(v)); }); });
+    else
+      array<int32_t>("Int32", name, 1, values.size(), [&](auto put) { each([&](int v) { put(static_cast<int32_t>(v)); }); });
+  }
+
+  // The triangles' corners and the offsets past each triangle's last.
+  template <class Index>
+  void polys(const char* type, const std::vector<std::array<int, 3>>& triangles) {
+    array<Index>(type, "connectivity", 1, 3 * triangles.size(), [&](auto put) {
+      for (const auto& t : triangles)
+        for (int v : t) put(static_cast<Index>(v));
+    });
+    array<Index>(type, "offsets", 1, triangles.size(), [&](auto put) {
+      for (size_t i = 0; i < triangles.size(); ++i) put(static_cast<Index>(3 * (i + 1)));
+    });
+  }
+};
+
+// VTK XML PolyData (version 1.0, 64-bit byte counts): opens in ParaView
+// with normals and attributes. Arrays are binary (base64) unless text is
+// asked for: formatting doubles as text took most of a morph frame's writing.
 void write_vtp(std::ostream& stream, const SurfaceMesh& mesh, const VertexAttributes* attributes,
                const MeshWriteOptions& options) {
   Sink out(stream);
-  const char* real = options.single_precision ? "Float32" : "Float64";
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "<PolyData>\n<Piece NumberOfPoints=\"" << mesh.vertices.size() << "\" NumberOfPolys=\""
-      << mesh.triangles.size() << "\">\n";
-  const int d = digits(options);
-  out << "<Points>\n<DataArray type=\"" << real << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& v : mesh.vertices) out << Reals3{v, d} << "\n";
-  out << "</DataArray>\n</Points>\n<PointData";
-  if (mesh.normals.size() == mesh.vertices.size()) out << " Normals=\"Normals\"";
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+         "header_type=\"UInt64\">\n<PolyData>\n<Piece NumberOfPoints=\""
+      << mesh.vertices.size() << "\" NumberOfPolys=\"" << mesh.triangles.size() << "\">\n";
+  VtpArrays arrays{out, options.ascii, digits(options)};
+  out << "<Points>\n";
+  arrays.reals3("", mesh.vertices, options.single_precision);
+  out << "</Points>\n<PointData";
+  const bool normals = mesh.normals.size() == mesh.vertices.size();
+  if (normals) out << " Normals=\"Normals\"";
   out << ">\n";
-  if (mesh.normals.size() == mesh.vertices.size()) {
-    out << "<DataArray type=\"" << real << "\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const auto& n : mesh.normals) out << Reals3{n, d} << "\n";
-    out << "</DataArray>\n";
-  }
+  if (normals) arrays.reals3("Normals", mesh.normals, options.single_precision);
   if (has(attributes, mesh)) {
     std::vector<VertexProperty> columns{{"patch", PropertyType::int32, attributes->patch},
                                         {"atom", PropertyType::int32, attributes->atom}};
     columns.insert(columns.end(), attributes->more.begin(), attributes->more.end());
-    for (const auto& [name, type, values] : columns) {
-      out << "<DataArray type=\"" << vtk_type(type) << "\" Name=\"" << name << "\" format=\"ascii\">\n";
-      for (int v : values) out << Integer{v} << "\n";
-      out << "</DataArray>\n";
-    }
+    for (const auto& [name, type, values] : columns) arrays.integers(type, name, values);
   }
-  out << "</PointData>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& t : mesh.triangles) out << Integer{t[0]} << " " << Integer{t[1]} << " " << Integer{t[2]} << "\n";
-  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (size_t i = 0; i < mesh.triangles.size(); ++i) out << Integer{3 * static_cast<long long>(i + 1)} << "\n";
-  out << "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  out << "</PointData>\n<Polys>\n";
+  // Offsets reach three times the triangles: Int32 while that fits.
+  if (3 * mesh.triangles.size() <= static_cast<size_t>(std::numeric_limits<int32_t>::max()))
+    arrays.polys<int32_t>("Int32", mesh.triangles);
+  else
+    arrays.polys<int64_t>("Int64", mesh.triangles);
+  out << "</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
 }
 
 }  // namespace

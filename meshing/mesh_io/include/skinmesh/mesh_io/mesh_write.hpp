@@ -49,7 +49,7 @@ struct VertexAttributes {
 
 struct MeshWriteOptions {
   bool single_precision = false;  // PLY float properties, 9 significant digits in text
-  bool ascii = false;             // PLY as text (17 or 9 significant digits): what PyMOL 2.5 reads
+  bool ascii = false;             // PLY and VTP as text (17 or 9 significant digits): PyMOL 2.5 reads text PLY only
 };
 
 // Every format but MSMS, whose two files have their own writers below.
