@@ -85,8 +85,9 @@ struct MovingOptions {
   // step when advance_to is told its balls. The frames are the same.
   bool build_ahead = true;
   RelaxationOptions relaxation;  // for the corners of failing triangles
-  // Every threshold of the repair (repair_policy.hpp), as the blend's but
-  // for five of the patch's. The largest patch: a third of the frame's
+  // Every threshold of the repair (repair_policy.hpp): its defaults (the
+  // blend's share of failing triangles is not taken) but for five of the
+  // patch's. The largest patch: a third of the frame's
   // vertices (with the patch's context), not 0.9. Moving atoms fail
   // triangles in many places at once (thermal motion: all over the
   // surface), and a patch past a third of the frame cost more than

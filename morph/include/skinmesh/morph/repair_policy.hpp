@@ -44,7 +44,7 @@ struct PatchPolicy {
   // the edits (a share, 0-1; 0, with always_patch_up_to 0: never); past it
   // the patches cover much of the mesh and remeshing the whole frame from
   // its vertices is faster. Moving atoms take these defaults; the blend
-  // takes a share of 0.02 (MorphOptions::repair).
+  // takes a share of 0.05 (MorphOptions::repair).
   double max_failing_share = 0.01;
   // ... or at most this many triangles, whatever the share (a count; 0:
   // the share alone). On a small frame the share is a few dozen triangles,
@@ -81,8 +81,8 @@ struct PatchPolicy {
   // seam or a new triangle failed; later attempts go on in pieces. The
   // frame is taken only when every vertex the first attempt touched ends
   // with one disk of triangles. The first attempt is most of a patch's
-  // work, and nearly all of it holds. Moving atoms turn it on
-  // (moving_balls.hpp); the blend's frames were not measured with it.
+  // work, and nearly all of it holds. Moving atoms and the blend turn it
+  // on (moving_balls.hpp, morph.hpp).
   bool retry_around_faults = false;
   // A patch whose refinement stalls (it needs more than twice its own
   // points: most often it meshes the far side of a thin gap that its
