@@ -79,7 +79,8 @@ struct MorphOptions {
   // replaces. With both, the four pairs of docs/benchmarks.md at 101
   // frames remeshed 1, 1, 5 and 0 frames whole, against 22, 11, 20 and 0
   // with 2% and every attempt whole, at the same time a frame within the
-  // spread between runs (docs/morph.md, "What is not there yet").
+  // spread between runs; the default 21 frames took 0.97-1.22 times as
+  // long, remeshing half as many (docs/benchmarks.md, docs/morph.md).
   RepairPolicy repair = [] {
     RepairPolicy r;
     r.patch.max_failing_share = 0.05;  // a share, 0-1
