@@ -72,15 +72,10 @@ struct MorphOptions {
   // (repair_policy.hpp). The blend patches frames with up to 5% of their
   // triangles failing after the edits (at least 200), and a patch's second
   // attempt meshes only around the first one's faults
-  // (PatchPolicy::retry_around_faults). A large patch between different
-  // molecules is one region that does not stitch at its first attempt;
-  // remeshed whole at every attempt (five, on 3al1 -> 1ubi at t = 0.75) it
-  // cost twice what it does around the faults, and more than the remesh it
-  // replaces. With both, the four pairs of docs/benchmarks.md at 101
-  // frames remeshed 1, 1, 5 and 0 frames whole, against 22, 11, 20 and 0
-  // with 2% and every attempt whole, at the same time a frame within the
-  // spread between runs; the default 21 frames took 0.97-1.22 times as
-  // long, remeshing half as many (docs/benchmarks.md, docs/morph.md).
+  // (PatchPolicy::retry_around_faults): a large patch between different
+  // molecules is one region that does not stitch at its first attempt, and
+  // remeshing that whole region at every attempt costs more than the
+  // whole-frame remesh it replaces (docs/morph.md, "What is not there yet").
   RepairPolicy repair = [] {
     RepairPolicy r;
     r.patch.max_failing_share = 0.05;  // a share, 0-1
