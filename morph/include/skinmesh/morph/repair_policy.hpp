@@ -60,8 +60,8 @@ struct PatchPolicy {
   // A patch that failed (other than by taking nearly the whole frame) is
   // tried once more from the start with this many more rings (a count; 0:
   // not), before the frame is remeshed whole. A wider region moves the
-  // seam off faults the narrow one could not grow past. Moving atoms turn
-  // it on (moving_balls.hpp).
+  // seam off faults the narrow one could not grow past. Both engines turn
+  // it on (MovingOptions::repair, MorphOptions::repair).
   int wider_rings = 0;
   // The patch grown around the seam's faults at most this many times;
   // past the fourth, not after two attempts in a row that left no fewer
