@@ -77,10 +77,10 @@ struct MorphOptions {
   // remeshing that whole region at every attempt costs more than the
   // whole-frame remesh it replaces (docs/morph.md, "What is not there yet").
   // A patch that fails is tried once more with one more ring
-  // (PatchPolicy::wider_rings) before the frame is remeshed whole: a patch
-  // whose seam faults would not go away mends with the wider region at a
-  // fraction of the remesh (3al1 -> 1ubi, 100 frames: none of its frames
-  // remeshed whole instead of two).
+  // (PatchPolicy::wider_rings) before the frame is remeshed whole: seam
+  // faults a one-ring patch cannot grow past mend with two rings at a
+  // fraction of the remesh (bench_morph's 3al1 -> 1ubi at 100 frames,
+  // frames 3 and 70).
   RepairPolicy repair = [] {
     RepairPolicy r;
     r.patch.max_failing_share = 0.05;  // a share, 0-1
