@@ -683,12 +683,14 @@ MorphOracleResult MorphOracle::evaluate(const Eigen::Vector3d& x, double t, cons
     if (pair.source >= 0 && pair.target >= 0) pairs.push_back(pair);
   }
   if (pairs.empty() || t == 0 || t == 1 || !x.allFinite()) return evaluate(x, t);
-  return solve_from(x, t, std::move(pairs));
+  const bool warm = pairs.size() <= 4;
+  return solve_from(x, t, std::move(pairs), warm);
 }
 
 // The pair solve from `pairs` (0 < t < 1), which grow by the violators the
 // KKT check finds until none is left.
-MorphOracleResult MorphOracle::solve_from(const Eigen::Vector3d& x, double t, std::vector<BallPair> pairs) const {
+MorphOracleResult MorphOracle::solve_from(const Eigen::Vector3d& x, double t, std::vector<BallPair> pairs,
+                                          bool warm) const {
   const double s = source_.shrink();
   const std::vector<Ball>& A = source_.balls();
   const std::vector<Ball>& B = target_.balls();
@@ -699,7 +701,7 @@ MorphOracleResult MorphOracle::solve_from(const Eigen::Vector3d& x, double t, st
     const Problem p{balls, s, x};
     std::vector<int> all(pairs.size());
     std::iota(all.begin(), all.end(), 0);
-    const Solution sol = solve_on(p, all);
+    const Solution sol = solve_on(p, all, warm && round == 0);
     const Stationary st = stationary(p, sol);
     take_solution(out, st, sol, [&](int candidate) { return pairs[static_cast<size_t>(candidate)]; });
     // Pair (i, j)'s multiplier is (1-t) g_i + t g_j, least at the least of each side.

@@ -98,13 +98,16 @@ class MorphOracle {
   // The same, with the pair solve started from `start` (e.g. the pairs of
   // the overlay cell a frame's vertex lies in) instead of the pairs of a few
   // balls of least power on each side; certified against every pair either
-  // way. At t = 0 or 1, and with no pair, as evaluate(x, t). Throws
+  // way. Up to four pairs (a cell's) all start in the working set: when they
+  // hold the minimiser's support, one step of the solve instead of a pair
+  // added per step. At t = 0 or 1, and with no pair, as evaluate(x, t). Throws
   // ContractError for a ball index past a side's last ball.
   MorphOracleResult evaluate(const Eigen::Vector3d& x, double t, const std::vector<BallPair>& start) const;
 
  private:
   SkinOracle source_, target_;
-  MorphOracleResult solve_from(const Eigen::Vector3d& x, double t, std::vector<BallPair> pairs) const;
+  // warm: the first solve starts from all the pairs (a start's).
+  MorphOracleResult solve_from(const Eigen::Vector3d& x, double t, std::vector<BallPair> pairs, bool warm = false) const;
 };
 
 }  // namespace skinmesh
