@@ -267,7 +267,10 @@ json frame_json(const FrameStats& s, const FrameCheck& c, const std::string& fil
           {"seconds_transport", s.seconds_transport},
           {"seconds_relax", s.seconds_relax},
           {"seconds_judge", s.seconds_judge},
-          {"seconds_repair", s.seconds_repair}};
+          {"seconds_repair", s.seconds_repair},
+          {"seconds_edits", s.seconds_edits},
+          {"seconds_patch", s.seconds_patch},
+          {"patch_attempts", s.patch_attempts}};
 }
 
 void print_progress(ProgressLine& line, const PaceEstimate& pace, size_t total, const FrameStats& s, long repairs) {

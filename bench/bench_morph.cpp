@@ -60,6 +60,7 @@ struct Column {
   double frames = 0, seconds = 0, seconds_first = 0, seconds_repair = 0;
   // (c) only: where the later frames' time went (FrameStats), summed.
   double seconds_complex = 0, seconds_transport = 0, seconds_relax = 0, seconds_judge = 0;
+  double seconds_edits = 0, seconds_patch = 0, patch_attempts = 0, patched_frames = 0;  // parts of the repair
   double triangles = 0, below_20 = 0, min_angle = 180;
   double max_error = 0, uncertified = 0;
   double invalid_frames = 0;  // not closed, manifold and oriented, or self-intersecting
@@ -111,6 +112,10 @@ Column run_morph(const Pair& p, int frames, bool local_repair) {
     c.seconds_transport += f.stats.seconds_transport;
     c.seconds_relax += f.stats.seconds_relax;
     c.seconds_judge += f.stats.seconds_judge;
+    c.seconds_edits += f.stats.seconds_edits;
+    c.seconds_patch += f.stats.seconds_patch;
+    c.patch_attempts += static_cast<double>(f.stats.patch_attempts);
+    c.patched_frames += f.stats.patch_attempts > 0;
     c.repaired += f.stats.repaired;
     c.remeshed += f.stats.remeshed;
     c.full_rebuilds += f.stats.full_rebuild;
@@ -237,14 +242,16 @@ void print_json(const Row& r, const Pair& p) {
       "\"repaired_frames\": %.0f, \"remeshed_frames\": %.0f, \"full_rebuilds\": %.0f, \"inserted_per_frame\": %.1f, "
       "\"removed_per_frame\": %.1f, \"relocated_per_frame\": %.1f, \"mean_vertices\": %.0f, "
       "\"later_frame_ms\": {\"complex\": %.3f, \"transport\": %.3f, \"relax\": %.3f, \"judge\": %.3f, "
-      "\"repair\": %.3f, \"whole\": %.3f}}\n",
+      "\"repair\": %.3f, \"of_repair_edits\": %.3f, \"of_repair_patch\": %.3f, \"whole\": %.3f}, "
+      "\"patched_frames\": %.0f, \"patch_attempts\": %.0f}\n",
       r.pair.c_str(), p.source.size(), p.target.size(), p.alignment.c_str(), r.column.c_str(),
       r.run.status.c_str(), c.frames, c.seconds / n, c.seconds_first, c.seconds_repair / n, r.run.peak_mb,
       c.triangles / n, c.min_angle, c.below_20 / std::max(1.0, c.triangles), c.max_error, c.uncertified,
       c.invalid_frames, c.repaired, c.remeshed, c.full_rebuilds, c.inserted / n, c.removed / n, c.relocated / n,
       c.vertices / n, later_ms(c, c.seconds_complex), later_ms(c, c.seconds_transport),
       later_ms(c, c.seconds_relax), later_ms(c, c.seconds_judge), later_ms(c, c.seconds_repair),
-      later_ms(c, c.seconds - c.seconds_first));
+      later_ms(c, c.seconds_edits), later_ms(c, c.seconds_patch), later_ms(c, c.seconds - c.seconds_first),
+      c.patched_frames, c.patch_attempts);
   std::fflush(stdout);
 }
 

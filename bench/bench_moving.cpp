@@ -190,6 +190,7 @@ Motion thermal_1ubi() {
 struct Column {
   double frames = 0, seconds = 0, seconds_first = 0;
   double seconds_complex = 0, seconds_transport = 0, seconds_relax = 0, seconds_judge = 0, seconds_repair = 0;
+  double seconds_edits = 0, seconds_patch = 0, patch_attempts = 0, patched_frames = 0;
   double triangles = 0, min_angle = 180, max_error = 0, invalid_frames = 0;
   double remeshed = 0, full_rebuilds = 0, steps = 0, min_ids_kept = 1, mean_ids_kept = 0, max_kept_move = 0;
   double max_atom_move = 0;
@@ -218,7 +219,8 @@ void log_frame(std::FILE* log, const std::string& motion, int k, const FrameStat
   const nlohmann::json j = {{"motion", motion}, {"frame", k}, {"seconds", s.seconds},
                             {"complex", s.seconds_complex}, {"transport", s.seconds_transport},
                             {"relax", s.seconds_relax}, {"judge", s.seconds_judge}, {"repair", s.seconds_repair},
-                            {"steps", s.steps}, {"triangles", s.triangles}, {"moved", s.moved},
+                            {"edits", s.seconds_edits}, {"patch", s.seconds_patch},
+                            {"patch_attempts", s.patch_attempts}, {"steps", s.steps}, {"triangles", s.triangles}, {"moved", s.moved},
                             {"relocated", s.relocated}, {"settled", s.settled}, {"carried", s.carried},
                             {"bad_triangles", s.bad_triangles},
                             {"events", s.events}, {"split", s.split}, {"flipped", s.flipped},
@@ -253,6 +255,10 @@ Column run_engine(const Motion& motion, int frames, const MovingOptions& options
     c.seconds_relax += s.seconds_relax;
     c.seconds_judge += s.seconds_judge;
     c.seconds_repair += s.seconds_repair;
+    c.seconds_edits += s.seconds_edits;
+    c.seconds_patch += s.seconds_patch;
+    c.patch_attempts += static_cast<double>(s.patch_attempts);
+    c.patched_frames += s.patch_attempts > 0;
     c.remeshed += s.remeshed;
     c.full_rebuilds += s.full_rebuild;
     c.steps += static_cast<double>(s.steps);
@@ -385,12 +391,14 @@ void print_json(const Row& r) {
       "\"min_angle\": %.3f, \"max_on_surface_error\": %.3e, \"invalid_frames\": %.0f, \"remeshed_frames\": %.0f, "
       "\"full_rebuilds\": %.0f, \"steps\": %.0f, \"min_ids_kept\": %.4f, \"mean_ids_kept\": %.4f, "
       "\"max_kept_move\": %.3f, \"max_atom_move_per_frame\": %.3f, \"later_frame_ms\": {\"complex\": %.3f, "
-      "\"transport\": %.3f, \"relax\": %.3f, \"judge\": %.3f, \"repair\": %.3f}}\n",
+      "\"transport\": %.3f, \"relax\": %.3f, \"judge\": %.3f, \"repair\": %.3f, \"of_repair_edits\": %.3f, "
+      "\"of_repair_patch\": %.3f}, \"patched_frames\": %.0f, \"patch_attempts\": %.0f}\n",
       r.motion.c_str(), r.atoms, r.column.c_str(), r.run.status.c_str(), c.frames, per_frame(r), c.seconds_first,
       r.run.peak_mb, c.triangles / std::max(1.0, c.frames), c.min_angle, c.max_error, c.invalid_frames, c.remeshed,
       c.full_rebuilds, c.steps, c.min_ids_kept, c.mean_ids_kept, c.max_kept_move, c.max_atom_move,
       later_ms(c, c.seconds_complex), later_ms(c, c.seconds_transport), later_ms(c, c.seconds_relax),
-      later_ms(c, c.seconds_judge), later_ms(c, c.seconds_repair));
+      later_ms(c, c.seconds_judge), later_ms(c, c.seconds_repair), later_ms(c, c.seconds_edits),
+      later_ms(c, c.seconds_patch), c.patched_frames, c.patch_attempts);
   std::fflush(stdout);
 }
 

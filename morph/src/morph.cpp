@@ -243,8 +243,11 @@ std::vector<char> Morph::Impl::move_vertices(const SkinComplex& next, SurfaceMes
 // the events say (the caller remeshes the frame).
 bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& failing,
                                  const detail::LocalRepairOptions& local) {
+  const auto start = Clock::now();
   detail::RepairResult r =
       detail::repair_locally(next, moved, failing, options_.repair_criteria(), options_.frames, local);
+  frame_.stats.seconds_patch += seconds_since(start);
+  frame_.stats.patch_attempts += r.attempts;
   if (!r.ok) {
     frame_.stats.remeshed_because = "the local patch failed: " + r.failed_because;
     return false;
@@ -259,12 +262,14 @@ bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& mov
 // its vertices. Returns how many triangles still fail.
 long Morph::Impl::mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                                 std::vector<char>& drop) {
+  const auto start = Clock::now();
   detail::RepairResult r = detail::mend_by_edits(next, std::move(moved), failing, options_.frames,
                                                  options_.repair.edits, &frame_.ids, &refused_thinning_);
   detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);
   moved = std::move(r.mesh);
   failing = std::move(r.failing);
   drop.assign(moved.vertices.size(), 0);
+  frame_.stats.seconds_edits += seconds_since(start);
   return r.left;
 }
 

@@ -1062,6 +1062,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     moved = std::move(edited.mesh);
     failing = std::move(edited.failing);
     left = edited.left;
+    s.seconds_edits += seconds_since(stage);
   }
   lost.assign(moved.vertices.size(), 0);  // the edits renumbered the vertices; none is lost
   std::string because;
@@ -1071,8 +1072,11 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
               std::to_string(static_cast<long>(share)) + ")";
   } else if (left > 0 || !local.changes.empty()) {
+    const auto patch_start = Clock::now();
     detail::RepairResult patched =
         detail::repair_locally(next, moved, failing, repair_criteria(), options_.frames, local);
+    s.seconds_patch += seconds_since(patch_start);
+    s.patch_attempts += patched.attempts;
     if (patched.ok) {
       detail::take_ids_and_counts(patched, frame_.ids, next_id_, s);
       moved = std::move(patched.mesh);

@@ -506,6 +506,13 @@ TEST_CASE("skinmesh morph writes a self-describing directory of checked frames",
       stages += j[key].get<double>();
     }
     CHECK(stages <= j["seconds"].get<double>());
+    // The edits and the patches are parts of the repair.
+    REQUIRE(j.contains("seconds_edits"));
+    REQUIRE(j.contains("seconds_patch"));
+    CHECK(j["seconds_edits"].get<double>() >= 0);
+    CHECK(j["seconds_patch"].get<double>() >= 0);
+    CHECK(j["seconds_edits"].get<double>() + j["seconds_patch"].get<double>() <= j["seconds_repair"].get<double>());
+    CHECK((j["patch_attempts"].get<long>() > 0) == (j["seconds_patch"].get<double>() > 0));
     CHECK(j["min_angle"].get<double>() >= 20.0);
     CHECK(j["max_onsurf_error"].get<double>() <= 1e-8);
     ++frames;

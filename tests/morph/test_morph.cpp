@@ -56,6 +56,12 @@ void check_stage_seconds(const FrameStats& s, const MorphOptions& options) {
   }
   if (!s.repaired && !s.full_rebuild) CHECK(s.seconds_repair == 0);
   if (s.repaired) CHECK(s.seconds_repair > 0);
+  // The edits and the patches are parts of the repair; a patch tried took time.
+  CHECK(s.seconds_edits >= 0);
+  CHECK(s.seconds_patch >= 0);
+  CHECK(s.seconds_edits + s.seconds_patch <= s.seconds_repair);
+  CHECK((s.patch_attempts > 0) == (s.seconds_patch > 0));
+  if (s.patch_triangles > 0) CHECK(s.patch_attempts > 0);
 }
 
 }  // namespace

@@ -701,6 +701,7 @@ TEST_CASE("moving balls: a step with few triangles failing after the edits is pa
   const std::vector<Ball>& from = models.first;
   const std::vector<Ball>& to = models.second;
   REQUIRE(from.size() == to.size());
+  long patched = 0;  // frames a patch mended
   const auto run = [&](long always_patch_up_to, long& remeshed, long& remeshed_for_share, long& least_share) {
     MovingOptions options;
     options.repair.patch.always_patch_up_to = always_patch_up_to;
@@ -712,6 +713,11 @@ TEST_CASE("moving balls: a step with few triangles failing after the edits is pa
       for (size_t i = 0; i < balls.size(); ++i) balls[i].center += k / 100.0 * (to[i].center - from[i].center);
       const MorphFrame& f = moving.advance_to(k == 100 ? to : balls, k / 100.0);
       CHECK(f.stats.topology_certified);
+      // The edits' and the patches' time are parts of the repair's.
+      CHECK(f.stats.seconds_edits + f.stats.seconds_patch <= f.stats.seconds_repair);
+      CHECK((f.stats.patch_attempts > 0) == (f.stats.seconds_patch > 0));
+      if (f.stats.patch_triangles > 0) CHECK(f.stats.patch_attempts > 0);
+      patched += f.stats.patch_triangles > 0;
       remeshed += f.stats.remeshed;
       const long share = test::remeshed_for_share(f.stats.remeshed_because);
       if (share >= 0) {
@@ -729,6 +735,7 @@ TEST_CASE("moving balls: a step with few triangles failing after the edits is pa
   REQUIRE(MovingOptions{}.repair.patch.always_patch_up_to == 200);
   CHECK((for_share == 0 || least >= 200));
   CHECK(remeshed < remeshed_by_share_alone);
+  CHECK(patched > 0);
 }
 
 TEST_CASE("moving balls: ubiquitin's atoms in thermal motion, voids opening and closing, every frame valid", "[moving][large]") {
