@@ -1012,6 +1012,7 @@ RepairResult patch_attempts(const SkinComplex& complex, const SurfaceMesh& given
       if (!topology_as_expected(given, mesh, options)) {
         out.failed_because = "the patched mesh's Euler characteristic or components are not what the topology "
                              "changes say";
+        out.wrong_topology = true;
         return out;
       }
       compact(std::move(mesh), given.vertices.size(), out);
@@ -1099,13 +1100,14 @@ RepairResult patch_with_contexts(const SkinComplex& complex, const SurfaceMesh& 
 }  // namespace
 
 // The patch with its contexts; when it fails, once more with
-// PatchPolicy::wider_rings more rings.
+// PatchPolicy::wider_rings more rings, unless its seam held and the
+// topology did not.
 RepairResult repair_locally(const SkinComplex& complex, const SurfaceMesh& given, const std::vector<char>& failing,
                            const MeshingOptions& repair, const MeshingOptions& accept,
                            const LocalRepairOptions& options) {
   bool too_large = false;
   RepairResult first = patch_with_contexts(complex, given, failing, repair, accept, options, too_large);
-  if (first.ok || too_large || options.policy.wider_rings <= 0) return first;
+  if (first.ok || too_large || first.wrong_topology || options.policy.wider_rings <= 0) return first;
   LocalRepairOptions wider = options;
   wider.policy.rings += options.policy.wider_rings;
   RepairResult again = patch_with_contexts(complex, given, failing, repair, accept, wider, too_large);

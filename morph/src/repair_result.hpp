@@ -30,6 +30,7 @@ struct RepairResult {
   long attempts = 0;           // local patch: attempts made (with a second round whole, both rounds')
   long attempted_triangles = 0;  // local patch: triangles of the region each attempt remeshed, summed
   long context_vertices = 0;     // local patch: context vertices each attempt's refinement held, summed
+  bool wrong_topology = false;   // local patch: the seam held, the Euler characteristic or components did not
   RepairCounts counts;
 };
 

@@ -374,6 +374,22 @@ TEST_CASE("local repair: a patch that fails is tried once more from the start wi
     REQUIRE(narrow.failed_because.find("nearly the whole frame") != std::string::npos);
     CHECK(patched_with(f, &PatchPolicy::wider_rings, 1).attempts == narrow.attempts);
   }
+  SECTION("a patch whose seam held with the wrong topology is not tried again") {
+    // The strand turned by 2 degrees is patched at the first round; told
+    // that the Euler characteristic changes by 2 (it does not), the patch
+    // holds at its seam and is refused by the topology check.
+    TurnedStrand f = turned_strand(570, 2);
+    REQUIRE(patched_with(f, &PatchPolicy::wider_rings, 0).ok);
+    f.options.euler_change += 2;
+    const detail::RepairResult narrow = patched_with(f, &PatchPolicy::wider_rings, 0);
+    REQUIRE_FALSE(narrow.ok);
+    REQUIRE(narrow.wrong_topology);
+    const detail::RepairResult wider = patched_with(f, &PatchPolicy::wider_rings, 1);
+    CHECK_FALSE(wider.ok);
+    CHECK(wider.wrong_topology);
+    CHECK(wider.attempts == narrow.attempts);
+    CHECK(wider.failed_because.find("with 2 rings") == std::string::npos);
+  }
 }
 
 namespace {
