@@ -111,11 +111,11 @@ size_t SkinComplex::slot_of(const std::array<int, 4>& tuple) const {
 void SkinComplex::index_cells() {
   size_t size = 16;
   while (size < 2 * cells_.size()) size *= 2;
-  cell_table_.assign(size, -1);
+  cell_table_.assign(size, CellSlot{{{-1, -1, -1, -1}}, -1});
   for (size_t c = 0; c < cells_.size(); ++c) {
     size_t at = slot_of(cells_[c].balls);
-    while (cell_table_[at] >= 0) at = (at + 1) & (size - 1);
-    cell_table_[at] = static_cast<int>(c);
+    while (cell_table_[at].cell >= 0) at = (at + 1) & (size - 1);
+    cell_table_[at] = CellSlot{cells_[c].balls, static_cast<int>(c)};
   }
 }
 
@@ -123,8 +123,11 @@ int SkinComplex::find_cell(std::array<int, 4> balls) const {
   if (cell_table_.empty()) return -1;
   const std::array<int, 4> tuple = ball_tuple(balls);
   for (size_t at = slot_of(tuple);; at = (at + 1) & (cell_table_.size() - 1)) {
-    const int c = cell_table_[at];
-    if (c < 0 || cells_[static_cast<size_t>(c)].balls == tuple) return c;
+    const CellSlot& slot = cell_table_[at];
+    // Compared one id at a time: std::array's == calls memcmp here.
+    if (slot.cell < 0 || (slot.balls[0] == tuple[0] && slot.balls[1] == tuple[1] && slot.balls[2] == tuple[2] &&
+                          slot.balls[3] == tuple[3]))
+      return slot.cell;
   }
 }
 

@@ -209,12 +209,18 @@ class SkinComplex {
   std::vector<int> coface_offset_;
   std::vector<Coface> cofaces_;
   // find_cell's table: open addressing with linear probing, a power of
-  // two at least twice the cells long, each slot a cell index (-1: empty)
-  // whose key is that cell's ball tuple in cells_. One array: a node per
-  // cell cost milliseconds to allocate and to free with every complex.
+  // two at least twice the cells long, each slot a cell's ball tuple and
+  // index (-1: empty). The key is kept in the slot: read from cells_, a
+  // probe cost a cache miss on a 200-byte cell, most of a lookup. One
+  // array: a node per cell cost milliseconds to allocate and to free with
+  // every complex.
+  struct CellSlot {
+    std::array<int, 4> balls;
+    int cell;
+  };
   void index_cells();
   size_t slot_of(const std::array<int, 4>& tuple) const;
-  std::vector<int> cell_table_;
+  std::vector<CellSlot> cell_table_;
   // Uniform grid over the centres of the non-hidden balls: a start for walks.
   Eigen::Vector3d grid_origin_ = Eigen::Vector3d::Zero();
   double grid_step_ = 1.0;
