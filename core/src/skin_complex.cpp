@@ -122,7 +122,11 @@ void SkinComplex::index_cells() {
 int SkinComplex::find_cell(std::array<int, 4> balls) const {
   if (cell_table_.empty()) return -1;
   const std::array<int, 4> tuple = ball_tuple(balls);
-  for (size_t at = slot_of(tuple);; at = (at + 1) & (cell_table_.size() - 1)) {
+  return find_cell_from(tuple, slot_of(tuple));
+}
+
+int SkinComplex::find_cell_from(const std::array<int, 4>& tuple, size_t slot) const {
+  for (size_t at = slot;; at = (at + 1) & (cell_table_.size() - 1)) {
     const CellSlot& slot = cell_table_[at];
     // Compared one id at a time: std::array's == calls memcmp here.
     if (slot.cell < 0 || (slot.balls[0] == tuple[0] && slot.balls[1] == tuple[1] && slot.balls[2] == tuple[2] &&

@@ -220,6 +220,8 @@ class SkinComplex {
   };
   void index_cells();
   size_t slot_of(const std::array<int, 4>& tuple) const;
+  // find_cell of a tuple already in ball_tuple's order, from its slot_of.
+  int find_cell_from(const std::array<int, 4>& tuple, size_t slot) const;
   std::vector<CellSlot> cell_table_;
   // Uniform grid over the centres of the non-hidden balls: a start for walks.
   Eigen::Vector3d grid_origin_ = Eigen::Vector3d::Zero();
