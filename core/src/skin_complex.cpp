@@ -110,7 +110,7 @@ size_t SkinComplex::slot_of(const std::array<int, 4>& tuple) const {
 
 void SkinComplex::index_cells() {
   size_t size = 16;
-  while (size < 2 * cells_.size()) size *= 2;
+  while (4 * size < 5 * cells_.size()) size *= 2;  // at most four fifths full
   cell_table_.assign(size, CellSlot{{{-1, -1, -1, -1}}, -1});
   for (size_t c = 0; c < cells_.size(); ++c) {
     size_t at = slot_of(cells_[c].balls);
