@@ -240,10 +240,12 @@ struct SkinComplexBuilder {
 
   // `keys` in the order of (dim, balls), ball ids below n: counted into
   // buckets by dimension and first ball, then each bucket (the simplices
-  // of one ball with higher ones, a few dozen) sorted alone. One sort of
-  // every key was a fifth of building 3mht's complex.
+  // of one ball with higher ones, a few dozen) sorted alone, in cache,
+  // instead of one sort of every key.
   static void sort_by_dimension_and_tuple(std::vector<Key>& keys, int n) {
-    const auto bucket = [n](const Key& k) { return static_cast<size_t>(k.dim) * static_cast<size_t>(n) + static_cast<size_t>(k.balls[0]); };
+    const auto bucket = [n](const Key& k) {
+      return static_cast<size_t>(k.dim) * static_cast<size_t>(n) + static_cast<size_t>(k.balls[0]);
+    };
     std::vector<int> first(4 * static_cast<size_t>(n) + 1, 0);
     for (const Key& k : keys) ++first[bucket(k) + 1];
     std::partial_sum(first.begin(), first.end(), first.begin());
@@ -321,8 +323,8 @@ struct SkinComplexBuilder {
     for (size_t i = 0; i < m; ++i) sc.face_offset_[i + 1] = sc.face_offset_[i] + (cells[i].dim > 0 ? cells[i].dim + 1 : 0);
     sc.faces_.assign(static_cast<size_t>(sc.face_offset_[m]), -1);
     // A face's slot in find_cell's table is found and fetched kAhead cells
-    // before it is read: the table (megabytes) misses the cache at nearly
-    // every lookup, and the lookups were a third of building the complex.
+    // before it is read: the table is megabytes long, and a lookup in it
+    // misses the cache but for the fetch.
     constexpr size_t kAhead = 16;
     std::array<std::array<size_t, 4>, kAhead> slots{};
     const auto fetch = [&](size_t i) {

@@ -73,8 +73,7 @@ std::vector<Edge> mark_cells_and_facets(Rt& rt, Counted& n) {
 }
 
 // Edges bucketed by their lesser vertex, each once: whether K's triangles
-// have an edge is a scan of a few entries. Sorting the edges and searching
-// them was a fifth of building and counting 3mht's complex.
+// have an edge is a scan of a few entries, in linear time to build.
 class EdgeSet {
  public:
   // `edges` (lesser vertex first, repeats allowed) between vertices below `indices`.
@@ -111,7 +110,8 @@ class EdgeSet {
     std::vector<Edge> out;
     out.reserve(higher_.size());
     for (size_t a = 0; a + 1 < first_.size(); ++a)
-      for (long k = first_[a]; k < first_[a + 1]; ++k) out.emplace_back(static_cast<long>(a), higher_[static_cast<size_t>(k)]);
+      for (long k = first_[a]; k < first_[a + 1]; ++k)
+        out.emplace_back(static_cast<long>(a), higher_[static_cast<size_t>(k)]);
     return out;
   }
 

@@ -209,11 +209,10 @@ class SkinComplex {
   std::vector<int> coface_offset_;
   std::vector<Coface> cofaces_;
   // find_cell's table: open addressing with linear probing, a power of
-  // two at least twice the cells long, each slot a cell's ball tuple and
-  // index (-1: empty). The key is kept in the slot: read from cells_, a
-  // probe cost a cache miss on a 200-byte cell, most of a lookup. One
-  // array: a node per cell cost milliseconds to allocate and to free with
-  // every complex.
+  // two at least 5/4 of the cells long, each slot a cell's ball tuple and
+  // index (-1: empty). The key is kept in the slot: read from cells_, each
+  // probe would miss the cache on a 200-byte cell. One array: a node per
+  // cell cost milliseconds to allocate and to free with every complex.
   struct CellSlot {
     std::array<int, 4> balls;
     int cell;
