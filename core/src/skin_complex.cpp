@@ -127,11 +127,11 @@ int SkinComplex::find_cell(std::array<int, 4> balls) const {
 
 int SkinComplex::find_cell_from(const std::array<int, 4>& tuple, size_t slot) const {
   for (size_t at = slot;; at = (at + 1) & (cell_table_.size() - 1)) {
-    const CellSlot& slot = cell_table_[at];
+    const CellSlot& entry = cell_table_[at];
     // Compared one id at a time: std::array's == calls memcmp here.
-    if (slot.cell < 0 || (slot.balls[0] == tuple[0] && slot.balls[1] == tuple[1] && slot.balls[2] == tuple[2] &&
-                          slot.balls[3] == tuple[3]))
-      return slot.cell;
+    if (entry.cell < 0 || (entry.balls[0] == tuple[0] && entry.balls[1] == tuple[1] &&
+                           entry.balls[2] == tuple[2] && entry.balls[3] == tuple[3]))
+      return entry.cell;
   }
 }
 
