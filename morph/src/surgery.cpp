@@ -18,6 +18,24 @@
 #include <utility>
 
 namespace skinmesh::detail {
+
+std::vector<RefusedEdges::Entry>::const_iterator RefusedEdges::find(const Key& key) const {
+  const auto it = std::lower_bound(entries_.begin(), entries_.end(), key,
+                                   [](const Entry& e, const Key& k) { return e.first < k; });
+  return it != entries_.end() && it->first == key ? it : entries_.end();
+}
+
+std::vector<RefusedEdges::Entry>::iterator RefusedEdges::find(const Key& key) {
+  const auto at = static_cast<const RefusedEdges&>(*this).find(key) - entries_.cbegin();
+  return entries_.begin() + at;
+}
+
+void RefusedEdges::sort() {
+  std::stable_sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.first < b.first; });
+  entries_.erase(std::unique(entries_.begin(), entries_.end(),
+                             [](const Entry& a, const Entry& b) { return a.first == b.first; }),
+                 entries_.end());
+}
 namespace {
 
 using Triangle = std::array<int, 3>;
@@ -509,6 +527,11 @@ class RefusalMemo {
     const long ia = (*ids_)[static_cast<size_t>(a)], ib = (*ids_)[static_cast<size_t>(b)];
     return std::make_pair(std::min(ia, ib), std::max(ia, ib));
   }
+  RefusalMemo(const RefusalMemo&) = delete;
+  RefusalMemo& operator=(const RefusalMemo&) = delete;
+  ~RefusalMemo() {
+    if (refused_) refused_->sort();
+  }
   // Refused in a frame before, neither shrunk since nor aged: skipped, and
   // remembered a frame older.
   bool still_refused(const std::optional<std::pair<long, long>>& key, double length) {
@@ -517,11 +540,11 @@ class RefusalMemo {
     if (it == before_.end()) return false;
     const auto [length_then, age] = it->second;
     if (length < (1 - options_.retry_shrink) * length_then || age + 1 >= options_.retry_after_frames) return false;
-    refused_->emplace(*key, std::make_pair(length_then, age + 1));
+    refused_->add(*key, length_then, age + 1);
     return true;
   }
   void refuse(const std::optional<std::pair<long, long>>& key, double length) {
-    if (key) refused_->emplace(*key, std::make_pair(length, 0));
+    if (key) refused_->add(*key, length, 0);
   }
 
  private:

@@ -21,7 +21,6 @@
 #include "skinmesh/morph/repair_policy.hpp"
 
 #include <functional>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -29,14 +28,32 @@ namespace skinmesh::detail {
 
 // Thinning contractions refused, by the vertex ids of the edge's ends
 // (smaller first): the edge's length then and the frames since. Kept by the
-// caller from frame to frame. Hashed: every short edge near a change looks
-// itself up in every frame, and nothing walks the memo in order.
-struct EdgeIdsHash {
-  size_t operator()(const std::pair<long, long>& e) const noexcept {
-    return std::hash<long>{}(e.first) ^ (std::hash<long>{}(e.second) * 0x9e3779b97f4a7c15ULL);
-  }
+// caller from frame to frame. Every short edge near a change looks itself
+// up in every frame, and each frame's memo is made anew: one array sorted
+// by the ids and searched by halving, with no allocation per edge.
+class RefusedEdges {
+ public:
+  using Key = std::pair<long, long>;
+  using Entry = std::pair<Key, std::pair<double, int>>;  // the ids; the length (Angstrom) and the frames since
+
+  bool empty() const { return entries_.empty(); }
+  size_t size() const { return entries_.size(); }
+  std::vector<Entry>::iterator begin() { return entries_.begin(); }
+  std::vector<Entry>::iterator end() { return entries_.end(); }
+  std::vector<Entry>::const_iterator begin() const { return entries_.begin(); }
+  std::vector<Entry>::const_iterator end() const { return entries_.end(); }
+  // The entry of `key`, or end(); the entries must be in order (sort).
+  std::vector<Entry>::const_iterator find(const Key& key) const;
+  std::vector<Entry>::iterator find(const Key& key);
+  // Appended in any order; sort() puts them in order, the first of a key kept.
+  void add(const Key& key, double length, int frames) { entries_.push_back({key, {length, frames}}); }
+  void sort();
+  void reserve(size_t n) { entries_.reserve(n); }
+  void swap(RefusedEdges& other) noexcept { entries_.swap(other.entries_); }
+
+ private:
+  std::vector<Entry> entries_;
 };
-using RefusedEdges = std::unordered_map<std::pair<long, long>, std::pair<double, int>, EdgeIdsHash>;
 
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
 // skin of `complex`; the others are taken to pass. With `ids` (per vertex of
