@@ -214,6 +214,8 @@ class Editor {
   Fan<int> star(int v) const;
   // The vertices around v, in the same order (the corner after v in each triangle).
   Fan<int> ring(int v) const;
+  // The ring of v from its star (`around`, star(v)): each triangle's corner after v.
+  Fan<int> ring_of(int v, const Fan<int>& around) const;
 
   Verdict judge(int f) const;
   bool should_flip(int a, int b) const;
@@ -280,9 +282,11 @@ Fan<int> Editor::star(int v) const {
   return out;
 }
 
-Fan<int> Editor::ring(int v) const {
+Fan<int> Editor::ring(int v) const { return ring_of(v, star(v)); }
+
+Fan<int> Editor::ring_of(int v, const Fan<int>& around) const {
   Fan<int> out;
-  for (int f : star(v)) {
+  for (int f : around) {
     const Triangle& t = tri(f);
     out.push_back(t[(static_cast<size_t>(std::find(t.begin(), t.end(), v) - t.begin()) + 1) % 3]);
   }
@@ -410,13 +414,12 @@ bool Editor::try_split(int f, std::vector<int>& touched) {
 bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
   const int f = face_of(gone, kept), g = face_of(kept, gone);
   if (f < 0 || g < 0) return false;
-  const Fan<int> around_gone = ring(gone);
+  const Fan<int> star_gone = star(gone);
+  const Fan<int> around_gone = ring_of(gone, star_gone);
   if (around_gone.size() < 3) return false;
   Fan<int> fan;  // triangles around `gone` that stay, with `kept` in its place
-  for (int v : around_gone) {
-    const int h = face_of(gone, v);
+  for (int h : star_gone)
     if (h != f && h != g) fan.push_back(h);
-  }
   Fan<Triangle> renamed;
   for (int h : fan) {
     Triangle t = tri(h);
