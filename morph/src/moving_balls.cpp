@@ -460,6 +460,29 @@ std::vector<int> inside_critical_cells(const SkinComplex& complex) {
   return out;
 }
 
+// What a step's two complexes, `from` before it and `to` after, say of its
+// balls before any vertex moves (step): computed beside the step before
+// when `to` is built ahead (build_ahead), so that the step starts with them.
+struct StepBalls {
+  std::vector<int> critical;                   // inside_critical_cells(to)
+  std::vector<Eigen::Matrix3d> rotations;      // neighbourhood_rotations
+  std::vector<char> quiet, rigid;              // quiet_balls, rigidly_moved_balls
+  std::optional<detail::RigidMotion> largest;  // largest_rigid_motion
+  std::vector<char> settled, carried;          // with_all_neighbours of `quiet` and of `rigid`
+};
+
+StepBalls step_balls(const SkinComplex& from, const SkinComplex& to) {
+  StepBalls b;
+  b.critical = inside_critical_cells(to);
+  b.rotations = neighbourhood_rotations(from, to.balls());
+  b.quiet = quiet_balls(from, to);
+  b.rigid = rigidly_moved_balls(from, to.balls(), b.rotations);
+  b.largest = largest_rigid_motion(from.balls(), to.balls(), b.rigid, b.rotations);
+  b.settled = with_all_neighbours(from, to, b.quiet);
+  b.carried = with_all_neighbours(from, to, b.rigid);
+  return b;
+}
+
 // The cells of `cells` (inside critical cells of `of`) whose ball tuple is
 // not an inside critical cell of `other`: each looked up by its tuple in
 // `other`'s table (SkinComplex::find_cell).
@@ -626,8 +649,9 @@ struct MovingBalls::Impl {
   ~Impl() { forget_ahead(); }
   const MorphFrame& advance_to(std::vector<Ball> balls, double t, const std::vector<Ball>& next);
   void step(std::vector<Ball> balls, const std::vector<Ball>* after);
-  void build_ahead();
-  bool take_ahead(const std::vector<Ball>& balls, std::optional<SkinComplex>& complex, SkinTopology& topology);
+  void build_ahead(const SkinComplex& now);
+  bool take_ahead(const std::vector<Ball>& balls, std::optional<SkinComplex>& complex, SkinTopology& topology,
+                  std::optional<StepBalls>& step_balls);
   void finish_ahead();
   void forget_ahead();
   void repair(const SkinComplex& next, const SkinTopology& topology, const std::vector<int>& critical,
@@ -646,6 +670,7 @@ struct MovingBalls::Impl {
 
   MovingOptions options_;
   SkinComplex complex_;
+  long generation_ = 0;  // how many times complex_ was replaced
   SkinTopology topology_;
   std::vector<int> critical_;  // cells of complex_ that are critical points inside the body (moving_balls.cpp)
   MorphFrame frame_;
@@ -662,6 +687,8 @@ struct MovingBalls::Impl {
     std::vector<Ball> balls;
     std::optional<SkinComplex> complex;
     SkinTopology topology;
+    std::optional<StepBalls> step;  // from the complex of complex_'s generation `from`
+    long from = -1;
   };
   Ahead ahead_;
   tbb::task_group building_ahead_;
@@ -671,27 +698,32 @@ struct MovingBalls::Impl {
 
 // Starts building the next step's complex (after_), if known and not
 // started: once the step's judging is done, whose parallel passes it would
-// slow, so that it runs beside the mostly serial edits and patch.
-void MovingBalls::Impl::build_ahead() {
+// slow, so that it runs beside the mostly serial edits and patch. With it
+// what it and `now`, the complex the step ends with, say of the balls
+// (StepBalls); `now` is read until finish_ahead.
+void MovingBalls::Impl::build_ahead(const SkinComplex& now) {
   if (!after_) return;
   forget_ahead();
   ahead_.balls = std::move(*after_);
   after_.reset();
-  building_ahead_.run([this] {
+  ahead_.from = generation_ + 1;  // the step ends with complex_ = now
+  building_ahead_.run([this, &now] {
     ahead_.complex.emplace(build_skin_complex(ahead_.balls, counting_topology(options_.shrink)));
     ahead_.topology = topology_of(*ahead_.complex);
+    ahead_.step = step_balls(now, *ahead_.complex);
   });
 }
 
 // The complex built ahead, when it was built for exactly `balls`; false
 // (and none kept) otherwise, or when its building failed.
 bool MovingBalls::Impl::take_ahead(const std::vector<Ball>& balls, std::optional<SkinComplex>& complex,
-                                   SkinTopology& topology) {
+                                   SkinTopology& topology, std::optional<StepBalls>& step_balls) {
   finish_ahead();
   const bool same = ahead_.complex.has_value() && same_balls(ahead_.balls, balls);
   if (same) {
     complex = std::move(ahead_.complex);
     topology = ahead_.topology;
+    if (ahead_.from == generation_) step_balls = std::move(ahead_.step);
   }
   ahead_ = Ahead{};
   return same;
@@ -831,19 +863,26 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   auto stage = Clock::now();
   std::optional<SkinComplex> built;
   SkinTopology topology;
-  const bool counted = take_ahead(balls, built, topology);
+  std::optional<StepBalls> known;
+  const bool counted = take_ahead(balls, built, topology, known);
   s.built_ahead += counted;
   if (!built) built.emplace(build_skin_complex(std::move(balls), counting_topology(options_.shrink)));
   SkinComplex next = std::move(*built);
+  // The complex built ahead reads `next` (build_ahead): done before `next` goes.
+  struct Finish {
+    Impl& impl;
+    ~Finish() { impl.finish_ahead(); }
+  } finish{*this};
   // The certificate's count comes with the complex; where the complex could
   // not count it (a flat triangulation), skin_topology runs beside the rest
   // of the step and is waited for before the repair.
   tbb::task_group counting;
   if (!counted && next.topology()) topology = *next.topology();
   else if (!counted) counting.run([&] { topology = skin_topology(next.balls()); });
-  std::vector<int> critical = inside_critical_cells(next);
-  const std::vector<Eigen::Matrix3d> rotations = neighbourhood_rotations(complex_, next.balls());
-  const std::vector<char> quiet = quiet_balls(complex_, next);
+  if (!known) known = step_balls(complex_, next);
+  std::vector<int> critical = std::move(known->critical);
+  const std::vector<Eigen::Matrix3d>& rotations = known->rotations;
+  const std::vector<char>& quiet = known->quiet;
   s.seconds_complex += seconds_since(stage);
   stage = Clock::now();
   SurfaceMesh moved = frame_.mesh;
@@ -855,9 +894,8 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // motion turns the cells it carried whole (cell_maps); thinning decides as
   // it did where the cells around a vertex moved so: the same edge lengths,
   // targets and fans.
-  const std::vector<char> rigid_balls = rigidly_moved_balls(complex_, next.balls(), rotations);
-  const std::optional<detail::RigidMotion> largest =
-      largest_rigid_motion(complex_.balls(), next.balls(), rigid_balls, rotations);
+  const std::vector<char>& rigid_balls = known->rigid;
+  const std::optional<detail::RigidMotion>& largest = known->largest;
   const CellMaps maps = cell_maps(complex_, next, rotations, quiet, largest, moved.cells);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
@@ -872,10 +910,10 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   // deep (with_all_neighbours of the quiet balls) sees the same skin around
   // it as before, so it keeps the verdict it had: it passed, when the step
   // before ended with every triangle judged passing.
-  const std::vector<char> settled_balls = with_all_neighbours(complex_, next, quiet);
+  const std::vector<char>& settled_balls = known->settled;
   // The judge's counterpart: a triangle whose corners moved with cells two
   // rings of rigid motion deep sees a congruent skin (judge.hpp).
-  const std::vector<char> carried_balls = with_all_neighbours(complex_, next, rigid_balls);
+  const std::vector<char>& carried_balls = known->carried;
   std::vector<char> lost(n, 0), stayed(n, 0);
   // A vertex that stayed where the skin within the judge's reach of it is
   // proven the same function (skin_unchanged_near) is settled as well:
@@ -940,7 +978,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   s.seconds_complex += seconds_since(stage);
   if (after && options_.build_ahead) after_ = *after;
   repair(next, topology, critical, moved, lost, stayed, std::move(settled));
-  build_ahead();  // when the repair did not start it
+  build_ahead(next);  // when the repair did not start it
   // Ids mean continuous motion (moving_balls.hpp): a vertex that
   // moved farther in the step than its bound, by transport, relaxation,
   // an edit or a remesh, is another point of the skin and takes a new id
@@ -952,7 +990,9 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
       frame_.ids[v] = next_id_++;
       ++s.reidentified;
     }
+  finish_ahead();
   complex_ = std::move(next);
+  ++generation_;
   topology_ = topology;
   critical_ = std::move(critical);
 }
@@ -1051,7 +1091,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   if (lost_count > 0 && !merge_lost(moved, lost, settled))
     return std::to_string(lost_count) + " vertices could not be put on the new skin nor merged into a neighbour";
   std::vector<char> failing = judge_and_relax(next, moved, settled);
-  build_ahead();
+  build_ahead(next);
   long left = std::count(failing.begin(), failing.end(), 1);
   const auto stage = Clock::now();
   if (left > 0 && options_.repair.edits.enabled) {
