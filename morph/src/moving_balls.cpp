@@ -464,6 +464,14 @@ std::vector<int> inside_critical_cells(const SkinComplex& complex) {
 // balls before any vertex moves (step): computed beside the step before
 // when `to` is built ahead (build_ahead), so that the step starts with them.
 struct StepBalls {
+  // The places of the step's topology changes (topology_changes,
+  // keep_events), when found beside the step before: none where the two
+  // complexes' topologies are the same.
+  struct Events {
+    std::vector<detail::TopologyChange> changes;
+    std::vector<detail::VanishingSphere> vanished;
+  };
+  std::optional<Events> events;
   std::vector<int> critical;                   // inside_critical_cells(to)
   std::vector<Eigen::Matrix3d> rotations;      // neighbourhood_rotations
   std::vector<char> quiet, rigid;              // quiet_balls, rigidly_moved_balls
@@ -649,7 +657,7 @@ struct MovingBalls::Impl {
   ~Impl() { forget_ahead(); }
   const MorphFrame& advance_to(std::vector<Ball> balls, double t, const std::vector<Ball>& next);
   void step(std::vector<Ball> balls, const std::vector<Ball>* after);
-  void build_ahead(const SkinComplex& now);
+  void build_ahead(const SkinComplex& now, const SkinTopology& now_topology, const std::vector<int>& now_critical);
   bool take_ahead(const std::vector<Ball>& balls, std::optional<SkinComplex>& complex, SkinTopology& topology,
                   std::optional<StepBalls>& step_balls);
   void finish_ahead();
@@ -671,6 +679,7 @@ struct MovingBalls::Impl {
   MovingOptions options_;
   SkinComplex complex_;
   long generation_ = 0;  // how many times complex_ was replaced
+  std::optional<StepBalls::Events> events_;  // of the step being made, when found with its complex built ahead
   SkinTopology topology_;
   std::vector<int> critical_;  // cells of complex_ that are critical points inside the body (moving_balls.cpp)
   MorphFrame frame_;
@@ -700,17 +709,26 @@ struct MovingBalls::Impl {
 // started: once the step's judging is done, whose parallel passes it would
 // slow, so that it runs beside the mostly serial edits and patch. With it
 // what it and `now`, the complex the step ends with, say of the balls
-// (StepBalls); `now` is read until finish_ahead.
-void MovingBalls::Impl::build_ahead(const SkinComplex& now) {
+// (StepBalls) and, when the topologies differ, where it changes between
+// them; `now` and `now_critical` (its inside critical cells) are read
+// until finish_ahead.
+void MovingBalls::Impl::build_ahead(const SkinComplex& now, const SkinTopology& now_topology,
+                                    const std::vector<int>& now_critical) {
   if (!after_) return;
   forget_ahead();
   ahead_.balls = std::move(*after_);
   after_.reset();
   ahead_.from = generation_ + 1;  // the step ends with complex_ = now
-  building_ahead_.run([this, &now] {
+  building_ahead_.run([this, &now, now_topology, &now_critical] {
     ahead_.complex.emplace(build_skin_complex(ahead_.balls, counting_topology(options_.shrink)));
     ahead_.topology = topology_of(*ahead_.complex);
-    ahead_.step = step_balls(now, *ahead_.complex);
+    StepBalls& step = ahead_.step.emplace(step_balls(now, *ahead_.complex));
+    StepBalls::Events& events = step.events.emplace();
+    if (ahead_.topology == now_topology) return;
+    detail::LocalRepairOptions found;
+    topology_changes(now, now_critical, *ahead_.complex, step.critical, false, found, events.vanished);
+    keep_events(now, *ahead_.complex, found, events.vanished);
+    events.changes = std::move(found.changes);
   });
 }
 
@@ -880,6 +898,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   if (!counted && next.topology()) topology = *next.topology();
   else if (!counted) counting.run([&] { topology = skin_topology(next.balls()); });
   if (!known) known = step_balls(complex_, next);
+  events_ = std::move(known->events);
   std::vector<int> critical = std::move(known->critical);
   const std::vector<Eigen::Matrix3d>& rotations = known->rotations;
   const std::vector<char>& quiet = known->quiet;
@@ -978,7 +997,7 @@ void MovingBalls::Impl::step(std::vector<Ball> balls, const std::vector<Ball>* a
   s.seconds_complex += seconds_since(stage);
   if (after && options_.build_ahead) after_ = *after;
   repair(next, topology, critical, moved, lost, stayed, std::move(settled));
-  build_ahead(next);  // when the repair did not start it
+  build_ahead(next, topology, critical);  // when the repair did not start it
   // Ids mean continuous motion (moving_balls.hpp): a vertex that
   // moved farther in the step than its bound, by transport, relaxation,
   // an edit or a remesh, is another point of the skin and takes a new id
@@ -1075,8 +1094,13 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   local.components_certified_after = true;  // mesh_topology below
   std::vector<detail::VanishingSphere> vanished;
   if (topology != topology_) {
-    topology_changes(complex_, critical_, next, critical, false, local, vanished);
-    keep_events(complex_, next, local, vanished);
+    if (events_) {  // found beside the step before
+      local.changes = std::move(events_->changes);
+      vanished = std::move(events_->vanished);
+    } else {
+      topology_changes(complex_, critical_, next, critical, false, local, vanished);
+      keep_events(complex_, next, local, vanished);
+    }
     s.events += static_cast<long>(local.changes.size() + vanished.size());
   }  // otherwise the critical cells that came or went are flips and cancelling pairs: no place to remesh
   local.euler_change = topology.euler - topology_.euler;
@@ -1091,7 +1115,7 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
   if (lost_count > 0 && !merge_lost(moved, lost, settled))
     return std::to_string(lost_count) + " vertices could not be put on the new skin nor merged into a neighbour";
   std::vector<char> failing = judge_and_relax(next, moved, settled);
-  build_ahead(next);
+  build_ahead(next, topology, critical);
   long left = std::count(failing.begin(), failing.end(), 1);
   const auto stage = Clock::now();
   if (left > 0 && options_.repair.edits.enabled) {
