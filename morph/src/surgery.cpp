@@ -36,6 +36,7 @@ void RefusedEdges::sort() {
                              [](const Entry& a, const Entry& b) { return a.first == b.first; }),
                  entries_.end());
 }
+
 namespace {
 
 using Triangle = std::array<int, 3>;
