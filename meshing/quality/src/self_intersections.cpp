@@ -92,19 +92,19 @@ bool triangles_cross(const SurfaceMesh& mesh, const std::array<int, 3>& a, const
 bool star_is_graph(const SurfaceMesh& mesh, int v, const std::vector<std::array<int, 2>>& link) {
   const size_t k = link.size();
   if (k < 3) return false;
-  // One cycle: each a starts one wedge and ends one, and following a -> b
-  // from the first wedge returns after k wedges.
-  for (size_t i = 0; i < k; ++i) {
-    int starts = 0, ends = 0;
-    for (const auto& w : link) starts += w[0] == link[i][0], ends += w[1] == link[i][0];
-    if (starts != 1 || ends != 1) return false;
+  // One cycle: the wedges' a are distinct and so are their b, and
+  // following a -> b from the first wedge meets every wedge once before
+  // it returns (each b then starts a wedge: the b are the a).
+  for (size_t i = 0; i < k; ++i)
+    for (size_t j = i + 1; j < k; ++j)
+      if ((link[i][0] == link[j][0]) | (link[i][1] == link[j][1])) return false;
+  size_t at = 0;
+  for (size_t step = 1; step <= k; ++step) {
+    size_t next = 0;
+    while (next < k && link[next][0] != link[at][1]) ++next;
+    if (next == k || (next == 0) != (step == k)) return false;
+    at = next;
   }
-  size_t steps = 0;
-  for (int at = link[0][1]; at != link[0][0] && steps <= k; ++steps) {
-    const auto next = std::find_if(link.begin(), link.end(), [&](const std::array<int, 2>& w) { return w[0] == at; });
-    at = (*next)[1];
-  }
-  if (steps + 1 != k) return false;
   const auto& V = mesh.vertices;
   const Eigen::Vector3d& c = V[static_cast<size_t>(v)];
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
@@ -238,13 +238,16 @@ struct PairCounter {
   const std::vector<double>* cut = nullptr;
   size_t slab = 0;
   long crossing = 0, unreported = 0;  // box pairs not yet added to shared.seen
-  void operator()(const Box* x, const Box* y) {
+  void count_pair() {
     // The shared count is updated in batches: an atomic add per pair would
     // cost more than most pairs' predicates.
     if (++unreported == 4096) {
       if (shared.seen.fetch_add(unreported) + unreported > shared.max || shared.over) throw OverBound{};
       unreported = 0;
     }
+  }
+  void operator()(const Box* x, const Box* y) {
+    count_pair();
     if (cut && !cut->empty() && owner_slab(*cut, *x, *y) != slab) return;
     const std::array<int, 3>& a = mesh.triangles[static_cast<size_t>(x->info())];
     const std::array<int, 3>& b = mesh.triangles[static_cast<size_t>(y->info())];
@@ -254,8 +257,8 @@ struct PairCounter {
   // where they share it or an edge through it (graph_stars).
   bool in_a_graph_star(const std::array<int, 3>& a, const std::array<int, 3>& b) const {
     if (!graph) return false;
-    for (int u : a)
-      if ((*graph)[static_cast<size_t>(u)] && std::find(b.begin(), b.end(), u) != b.end()) return true;
+    for (int u : a)  // three comparisons, not std::find, which was not inlined
+      if ((u == b[0]) | (u == b[1]) | (u == b[2]) && (*graph)[static_cast<size_t>(u)]) return true;
     return false;
   }
 };
@@ -410,6 +413,14 @@ class BoxGrid {
               for (size_t i = 0; i < found; ++i) {
                 const Item& q = items_[near[i]];
                 if (owner(p, q) != c) continue;
+                // Most pairs share a vertex whose star is a graph: decided
+                // from their corners before their boxes are read again
+                // (boxes that share a corner meet).
+                if (counter.in_a_graph_star(mesh.triangles[static_cast<size_t>(p.triangle)],
+                                            mesh.triangles[static_cast<size_t>(q.triangle)])) {
+                  counter.count_pair();
+                  continue;
+                }
                 const Box& x = *boxes[static_cast<size_t>(p.box)];
                 const Box& y = *boxes[static_cast<size_t>(q.box)];
                 if (meet(x, y)) counter(&x, &y);
@@ -428,6 +439,7 @@ class BoxGrid {
   struct Item {
     float lo[3], hi[3];
     int box;
+    int triangle;  // the box's (its info)
     int first[3];  // the box's first cell
   };
   Item item_of(const Box& b, int box) const {
@@ -440,6 +452,7 @@ class BoxGrid {
       if (item.hi[k] < b.max_coord(k)) item.hi[k] = std::nextafter(item.hi[k], std::numeric_limits<float>::infinity());
     }
     item.box = box;
+    item.triangle = b.info();
     return item;
   }
   // Bitwise and, not &&: one value to branch on (or none, above).
