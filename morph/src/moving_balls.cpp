@@ -710,8 +710,9 @@ struct MovingBalls::Impl {
 // slow, so that it runs beside the mostly serial edits and patch. With it
 // what it and `now`, the complex the step ends with, say of the balls
 // (StepBalls) and, when the topologies differ, where it changes between
-// them; `now` and `now_critical` (its inside critical cells) are read
-// until finish_ahead.
+// them; `now` is read until finish_ahead, `now_critical` (its inside
+// critical cells) is copied: the step's own list can go first when an
+// exception unwinds the step.
 void MovingBalls::Impl::build_ahead(const SkinComplex& now, const SkinTopology& now_topology,
                                     const std::vector<int>& now_critical) {
   if (!after_) return;
@@ -719,7 +720,7 @@ void MovingBalls::Impl::build_ahead(const SkinComplex& now, const SkinTopology& 
   ahead_.balls = std::move(*after_);
   after_.reset();
   ahead_.from = generation_ + 1;  // the step ends with complex_ = now
-  building_ahead_.run([this, &now, now_topology, &now_critical] {
+  building_ahead_.run([this, &now, now_topology, now_critical] {
     ahead_.complex.emplace(build_skin_complex(ahead_.balls, counting_topology(options_.shrink)));
     ahead_.topology = topology_of(*ahead_.complex);
     StepBalls& step = ahead_.step.emplace(step_balls(now, *ahead_.complex));
