@@ -446,12 +446,22 @@ struct Least {
   int ball = -1;
   double g = INFINITY;
 };
-Least least_multiplier(const BallGrid& grid, const Problem& side, const Eigen::Vector3d& r) {
+// With `seeds` (balls of this side, such as the support's): the least of
+// their multipliers bounds the least of all, and one pass over the balls
+// within that value's reach finds it (without seeds, a first pass over the
+// balls near x gives the bound, and most calls need the second pass).
+Least least_multiplier(const BallGrid& grid, const Problem& side, const Eigen::Vector3d& r,
+                       const std::vector<int>& seeds = {}) {
   Least least;
   const auto take = [&](int k) {
     const double g = side.gradient_entry(k, r);
     if (g < least.g) least = {k, g};
   };
+  if (!seeds.empty()) {
+    for (int k : seeds) take(k);
+    visit_near(grid, side.balls, side.x, certification_radius(side.s, r, least.g, grid.max_weight()), take);
+    return least;
+  }
   const double near = std::sqrt(std::max(grid.max_weight(), 0.0)) + 1.0;
   visit_near(grid, side.balls, side.x, near, take);
   // Balls beyond `reach` have g_k >= least.g; one more pass settles it
@@ -704,8 +714,15 @@ MorphOracleResult MorphOracle::solve_from(const Eigen::Vector3d& x, double t, st
     const Solution sol = solve_on(p, all, warm && round == 0);
     const Stationary st = stationary(p, sol);
     take_solution(out, st, sol, [&](int candidate) { return pairs[static_cast<size_t>(candidate)]; });
-    // Pair (i, j)'s multiplier is (1-t) g_i + t g_j, least at the least of each side.
-    const Least a = least_multiplier(*source_.grid_, side_a, st.r), b = least_multiplier(*target_.grid_, side_b, st.r);
+    // Pair (i, j)'s multiplier is (1-t) g_i + t g_j, least at the least of
+    // each side, sought from the support's balls on that side.
+    std::vector<int> seeds_a, seeds_b;
+    for (int k : sol.support) {
+      seeds_a.push_back(pairs[static_cast<size_t>(k)].source);
+      seeds_b.push_back(pairs[static_cast<size_t>(k)].target);
+    }
+    const Least a = least_multiplier(*source_.grid_, side_a, st.r, seeds_a);
+    const Least b = least_multiplier(*target_.grid_, side_b, st.r, seeds_b);
     const double least = (1 - t) * a.g + t * b.g;
     out.kkt_violation = std::max(st.violation, (st.mu - least) / st.scale);
     out.certified = out.kkt_violation < 1e-9;
