@@ -428,20 +428,13 @@ bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
     if (!faces_out(t)) return false;
     renamed.push_back(t);
   }
-  // The tests that need no skin first, the shape (which refuses most
-  // thinning contractions) before the link condition, whose rings cost more.
+  // The tests cheapest for what they refuse first: the shape; then each
+  // triangle judged, the widest first (most thinning contractions are
+  // refused for size or distance, which the widest triangle fails first,
+  // and the first failure ends the judging), on a copy of each triangle;
+  // last the link condition, whose rings cost more and which seldom refuses.
   for (const Triangle& t : renamed)
     if (!shape_passes({at(t[0]), at(t[1]), at(t[2])}, accept_.min_angle)) return false;
-  const Fan<int> around_kept = ring(kept);
-  if (around_kept.size() < 3 || around_gone.size() + around_kept.size() < 8) return false;
-  long common = 0;
-  for (int v : around_gone) common += std::count(around_kept.begin(), around_kept.end(), v);
-  if (common != 2) return false;
-  // The corners opposite the edge lose a neighbour: each keeps three.
-  if (star(third(f, gone, kept)).size() < 4 || star(third(g, gone, kept)).size() < 4) return false;
-  // Then judged whole before the edit, on a copy of each triangle, the
-  // widest first: most refusals are for size or distance, which the widest
-  // triangle fails first, and the first failure ends the judging.
   Fan<std::pair<double, size_t>> widest_first;
   for (size_t i = 0; i < fan.size(); ++i) {
     const Triangle& t = renamed[i];
@@ -456,6 +449,13 @@ bool Editor::contract(int gone, int kept, std::vector<int>& touched) {
     mesh_.triangles[static_cast<size_t>(fan[i])] = saved;
     if (!passes) return false;
   }
+  const Fan<int> around_kept = ring(kept);
+  if (around_kept.size() < 3 || around_gone.size() + around_kept.size() < 8) return false;
+  long common = 0;
+  for (int v : around_gone) common += std::count(around_kept.begin(), around_kept.end(), v);
+  if (common != 2) return false;
+  // The corners opposite the edge lose a neighbour: each keeps three.
+  if (star(third(f, gone, kept)).size() < 4 || star(third(g, gone, kept)).size() < 4) return false;
   detach(f);
   detach(g);
   for (int h : fan) detach(h);
