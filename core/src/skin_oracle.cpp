@@ -446,28 +446,36 @@ struct Least {
   int ball = -1;
   double g = INFINITY;
 };
-// With `seeds` (balls of this side, such as the support's): the least of
-// their multipliers bounds the least of all, and one pass over the balls
-// within that value's reach finds it (without seeds, a first pass over the
-// balls near x gives the bound, and most calls need the second pass).
-Least least_multiplier(const BallGrid& grid, const Problem& side, const Eigen::Vector3d& r,
-                       const std::vector<int>& seeds = {}) {
+Least least_multiplier(const BallGrid& grid, const Problem& side, const Eigen::Vector3d& r) {
   Least least;
   const auto take = [&](int k) {
     const double g = side.gradient_entry(k, r);
     if (g < least.g) least = {k, g};
   };
-  if (!seeds.empty()) {
-    for (int k : seeds) take(k);
-    visit_near(grid, side.balls, side.x, certification_radius(side.s, r, least.g, grid.max_weight()), take);
-    return least;
-  }
   const double near = std::sqrt(std::max(grid.max_weight(), 0.0)) + 1.0;
   visit_near(grid, side.balls, side.x, near, take);
   // Balls beyond `reach` have g_k >= least.g; one more pass settles it
   // (least.g only falls, so the reach of its result is no larger).
   const double reach = certification_radius(side.s, r, least.g, grid.max_weight());
   if (!(reach <= near)) visit_near(grid, side.balls, side.x, reach, take);
+  return least;
+}
+
+// The same from seeds, balls of this side such as the support's
+// (each_seed(take) calls take(k) for each): the least of their
+// multipliers bounds the least of all, and one pass over the balls within
+// that value's reach finds it, where without seeds a first pass over the
+// balls near x gives the bound and most calls need the second pass.
+template <class EachSeed>
+Least least_multiplier_from(const BallGrid& grid, const Problem& side, const Eigen::Vector3d& r, EachSeed each_seed) {
+  Least least;
+  const auto take = [&](int k) {
+    const double g = side.gradient_entry(k, r);
+    if (g < least.g) least = {k, g};
+  };
+  each_seed(take);
+  if (least.ball < 0) return least_multiplier(grid, side, r);
+  visit_near(grid, side.balls, side.x, certification_radius(side.s, r, least.g, grid.max_weight()), take);
   return least;
 }
 
@@ -716,13 +724,12 @@ MorphOracleResult MorphOracle::solve_from(const Eigen::Vector3d& x, double t, st
     take_solution(out, st, sol, [&](int candidate) { return pairs[static_cast<size_t>(candidate)]; });
     // Pair (i, j)'s multiplier is (1-t) g_i + t g_j, least at the least of
     // each side, sought from the support's balls on that side.
-    std::vector<int> seeds_a, seeds_b;
-    for (int k : sol.support) {
-      seeds_a.push_back(pairs[static_cast<size_t>(k)].source);
-      seeds_b.push_back(pairs[static_cast<size_t>(k)].target);
-    }
-    const Least a = least_multiplier(*source_.grid_, side_a, st.r, seeds_a);
-    const Least b = least_multiplier(*target_.grid_, side_b, st.r, seeds_b);
+    const Least a = least_multiplier_from(*source_.grid_, side_a, st.r, [&](const auto& take) {
+      for (int k : sol.support) take(pairs[static_cast<size_t>(k)].source);
+    });
+    const Least b = least_multiplier_from(*target_.grid_, side_b, st.r, [&](const auto& take) {
+      for (int k : sol.support) take(pairs[static_cast<size_t>(k)].target);
+    });
     const double least = (1 - t) * a.g + t * b.g;
     out.kkt_violation = std::max(st.violation, (st.mu - least) / st.scale);
     out.certified = out.kkt_violation < 1e-9;
