@@ -232,12 +232,7 @@ FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleSt
   return check;
 }
 
-// The m x n morph's frames.jsonl line: the common fields and its events.
-json blend_frame_json(const FrameStats& s, const FrameCheck& c, const std::string& file) {
-  json j = frame_json(s, c, file);
-  j["events"] = s.events;
-  return j;
-}
+
 
 // A frame of the blend copied out of the morph, with what writing it needs,
 // so that it is checked and written while the next frame is made.
@@ -502,7 +497,7 @@ bool make_blend_frames(Morph& morph, const std::vector<double>& times, const Fra
   tbb::task_group checking;  // after what its task reads: if advance_to throws, it waits before they go
   const auto finish = [&]() {
     checking.wait();
-    const json line = blend_frame_json(pending.frame.stats, check, out.files.listed_file(pending.index));
+    const json line = frame_json(pending.frame.stats, check, out.files.listed_file(pending.index));
     if (!check.holds()) {
       out.shown.finish();
       std::cerr << "skinmesh: error: frame " << pending.index << " (t = " << pending.t

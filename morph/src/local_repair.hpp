@@ -36,6 +36,13 @@ struct TopologyChange {
   bool birth = false;
   double size = 0;  // Angstrom
   int cell = -1;
+  // The event's dimension, its change of the skin's Euler characteristic (0
+  // when another event of the step cancels it) and, for a neck (dimension 1
+  // or 2), its cell in the complex after the step (-1: not there), where
+  // neck_surgery (necks.hpp) reads the skin's quadric.
+  int dim = -1;
+  int euler_change = 0;
+  int neck_cell = -1;
 };
 
 struct LocalRepairOptions {

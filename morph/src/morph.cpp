@@ -13,6 +13,7 @@
 #include "judge.hpp"
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
+#include "necks.hpp"
 #include "surgery.hpp"
 #include "vanishing.hpp"
 
@@ -70,6 +71,9 @@ void add_topology_changes(const std::vector<TopologyEvent>& events, const std::v
     change.birth = sphere && e.euler_change > 0 && !cancelled;
     change.size = feature;
     change.cell = e.cell;
+    change.dim = e.dim;
+    change.euler_change = cancelled ? 0 : e.euler_change;
+    change.neck_cell = e.dim == 1 || e.dim == 2 ? e.cell : -1;
     local.changes.push_back(change);
     if (!cancelled) local.euler_change += e.euler_change;
   }
@@ -97,6 +101,8 @@ struct Morph::Impl {
                          const std::vector<SkinSample>& seeds = {});
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop,
               const std::vector<SkinSample>& seeds);
+  long mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing, std::vector<char>& drop,
+                  detail::LocalRepairOptions& local, long left);
   long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                      std::vector<char>& drop);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
@@ -255,6 +261,29 @@ bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& mov
   detail::take_ids_and_counts(r, frame_.ids, next_id_, frame_.stats);  // inserted and removed: by ids (advance_to)
   frame_.mesh = std::move(r.mesh);
   return true;
+}
+
+// The necks that open or pinch in the frame's step cut and joined or
+// capped (necks.hpp), their new triangles left failing for the edits; the
+// changes made leave the patch's places and the Euler characteristic it
+// must make. Returns how many triangles fail (`left` when none was made).
+long Morph::Impl::mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+                             std::vector<char>& drop, detail::LocalRepairOptions& local, long left) {
+  const auto start = Clock::now();
+  std::vector<char> done;
+  detail::RepairResult cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
+  frame_.stats.seconds_edits += seconds_since(start);
+  if (!cut.ok) return left;
+  std::vector<char> dropped(cut.origin.size(), 0);
+  for (size_t v = 0; v < dropped.size(); ++v)
+    if (cut.origin[v] >= 0 && static_cast<size_t>(cut.origin[v]) < drop.size())
+      dropped[v] = drop[static_cast<size_t>(cut.origin[v])];
+  drop = std::move(dropped);
+  detail::take_ids_and_counts(cut, frame_.ids, next_id_, frame_.stats);
+  moved = std::move(cut.mesh);
+  failing = std::move(cut.failing);
+  frame_.stats.necks += detail::take_done_changes(done, local);
+  return cut.left;
 }
 
 // The failing triangles mended by edits of the mesh (surgery.hpp); `moved`,
@@ -539,6 +568,8 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
   add_topology_changes(events_, sizes_, t_, t, moved.handled, moved.partner, local);
   const bool mendable = moved.lost_left == 0;
   long left = stats.bad_triangles;
+  if (mendable && !local.changes.empty() && options_.repair.neck_surgery && options_.repair.edits.enabled)
+    left = mend_necks(next, moved.mesh, moved.failing, moved.drop, local, left);
   if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop);
   if (mendable && local.changes.empty() && left == 0) {
     frame_.mesh = std::move(moved.mesh);

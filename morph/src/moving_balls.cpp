@@ -7,6 +7,7 @@
 #include "judge.hpp"
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
+#include "necks.hpp"
 #include "surgery.hpp"
 #include "unchanged_skin.hpp"
 #include "vanishing.hpp"
@@ -552,25 +553,31 @@ void topology_changes(const SkinComplex& from, const std::vector<int>& from_crit
       }
     if (!paired) really_gone.push_back(g);
   }
-  const auto place = [&](const MixedCell& cell, int index, bool birth) {
+  // euler: the change of the skin's Euler characteristic, +-2 (-1)^dim for
+  // a critical cell that came or went; neck: the cell in `to` (dimension 1 or 2).
+  const auto place = [&](const MixedCell& cell, int index, bool birth, int euler, int neck) {
     detail::TopologyChange change;
     change.point = cell.center;
     change.size = std::sqrt(std::abs(cell.R2));
     change.radius = 1.0 + 2 * change.size;
     change.birth = birth;
     change.cell = index;
+    change.dim = cell.dim;
+    change.euler_change = same_topology ? 0 : euler;
+    change.neck_cell = cell.dim == 1 || cell.dim == 2 ? neck : -1;
     local.changes.push_back(change);
   };
   for (size_t k = 0; k < came.size(); ++k) {
     if (renamed[k]) continue;
     const MixedCell& cell = *came[k];
-    if (same_topology) place(cell, came_index[k], false);  // a pair of critical points that cancel
+    const int euler = cell.dim % 2 ? -2 : 2;
+    if (same_topology) place(cell, came_index[k], false, 0, -1);  // a pair of critical points that cancel
     else if (cell.dim == 3) vanished.push_back({cell.center, 1.0 + 2 * std::sqrt(std::abs(cell.R2))});
-    else place(cell, came_index[k], cell.dim == 0);
+    else place(cell, came_index[k], cell.dim == 0, euler, came_index[k]);
   }
   for (const MixedCell* g : really_gone) {
     if (same_topology) {
-      place(*g, -1, false);
+      place(*g, -1, false, 0, -1);
       continue;
     }
     if (g->dim == 0) {
@@ -578,7 +585,7 @@ void topology_changes(const SkinComplex& from, const std::vector<int>& from_crit
       continue;
     }
     const int now = g->dim == 3 ? to.find_cell(g->balls) : -1;
-    place(now >= 0 ? to.cell(now) : *g, now, now >= 0);
+    place(now >= 0 ? to.cell(now) : *g, now, now >= 0, g->dim % 2 ? 2 : -2, to.find_cell(g->balls));
   }
 }
 
@@ -671,6 +678,21 @@ struct MovingBalls::Impl {
   bool drop_vanished(const std::vector<detail::VanishingSphere>& vanished, const std::vector<char>& stayed,
                      SurfaceMesh& moved, std::vector<char>& lost, Settled& settled, long& euler_change);
   bool merge_lost(SurfaceMesh& moved, std::vector<char>& lost, Settled& settled);
+  struct Unmended;
+  bool mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing, Settled& settled,
+                  detail::LocalRepairOptions& local, Unmended& before);
+  std::string edit_and_patch(const SkinComplex& next, const SkinTopology& topology, SurfaceMesh& moved,
+                             std::vector<char>& lost, std::vector<char>& failing, Settled& settled,
+                             detail::LocalRepairOptions& local);
+  // What mend_locally had before a neck surgery, to mend the frame again without it.
+  struct Unmended {
+    SurfaceMesh mesh;
+    std::vector<char> failing;
+    std::vector<long> ids;
+    long next_id = 0;
+    std::vector<char> thinning;
+    detail::LocalRepairOptions local;
+  };
   void keep_vertices(const std::vector<int>& kept_from, std::vector<char>& lost, Settled& settled);
   bool remesh(const SkinComplex& next, const SurfaceMesh& moved, std::vector<char>& drop, const MeshingOptions& criteria,
               const std::vector<SkinSample>& seeds);
@@ -1117,6 +1139,36 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     return std::to_string(lost_count) + " vertices could not be put on the new skin nor merged into a neighbour";
   std::vector<char> failing = judge_and_relax(next, moved, settled);
   build_ahead(next, topology, critical);
+  if (local.changes.empty() || !options_.repair.neck_surgery || !options_.repair.edits.enabled)
+    return edit_and_patch(next, topology, moved, lost, failing, settled, local);
+  // Necks mended by surgery first; when the edits and the patch cannot
+  // finish the frame after it, the frame is mended again from before it,
+  // the patch remeshing around every change, before it is remeshed whole.
+  Unmended before;
+  const long necks_before = s.necks;  // of the frame's earlier steps
+  if (!mend_necks(next, moved, failing, settled, local, before))
+    return edit_and_patch(next, topology, moved, lost, failing, settled, local);
+  const std::string because = edit_and_patch(next, topology, moved, lost, failing, settled, local);
+  if (because.empty()) return because;
+  s.necks_undone += s.necks - necks_before;
+  s.necks = necks_before;
+  moved = std::move(before.mesh);
+  failing = std::move(before.failing);
+  frame_.ids = std::move(before.ids);
+  next_id_ = before.next_id;
+  settled.thinning = std::move(before.thinning);
+  local = std::move(before.local);
+  lost.assign(moved.vertices.size(), 0);
+  return edit_and_patch(next, topology, moved, lost, failing, settled, local);
+}
+
+// Edits, then a local patch around what still fails and the topology
+// changes left in `local`, then the certificate (mend_locally). Returns ""
+// with the frame made, else why not.
+std::string MovingBalls::Impl::edit_and_patch(const SkinComplex& next, const SkinTopology& topology,
+                                              SurfaceMesh& moved, std::vector<char>& lost, std::vector<char>& failing,
+                                              Settled& settled, detail::LocalRepairOptions& local) {
+  FrameStats& s = frame_.stats;
   long left = std::count(failing.begin(), failing.end(), 1);
   const auto stage = Clock::now();
   if (left > 0 && options_.repair.edits.enabled) {
@@ -1177,6 +1229,33 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
   moved = detail::used_part(moved, keep, kept_from);
   keep_vertices(kept_from, lost, settled);
   euler_change += 2 * static_cast<long>(vanished.size());
+  return true;
+}
+
+// The necks that opened or pinched in the step cut and joined or capped
+// (necks.hpp), their new triangles left failing for the edits; the changes
+// made leave the patch's places and the Euler characteristic it must make.
+// False, nothing changed, when none was made; else `before` holds the frame
+// as it was.
+bool MovingBalls::Impl::mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+                                   Settled& settled, detail::LocalRepairOptions& local, Unmended& before) {
+  const auto start = Clock::now();
+  std::vector<char> done;
+  detail::RepairResult cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
+  const double seconds = seconds_since(start);
+  frame_.stats.seconds_edits += seconds;
+  frame_.stats.seconds_repair += seconds;
+  if (!cut.ok) return false;
+  std::vector<char> thinning(cut.origin.size(), 0);
+  if (!settled.thinning.empty())
+    for (size_t v = 0; v < thinning.size(); ++v)
+      if (cut.origin[v] >= 0) thinning[v] = settled.thinning[static_cast<size_t>(cut.origin[v])];
+  before = {std::move(moved), std::move(failing), frame_.ids, next_id_, std::move(settled.thinning), local};
+  settled.thinning = std::move(thinning);
+  detail::take_ids_and_counts(cut, frame_.ids, next_id_, frame_.stats);
+  moved = std::move(cut.mesh);
+  failing = std::move(cut.failing);
+  frame_.stats.necks += detail::take_done_changes(done, local);
   return true;
 }
 

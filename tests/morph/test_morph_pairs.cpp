@@ -263,6 +263,28 @@ TEST_CASE("synthetic events: two balls merge, and the neck pinches off going bac
   }
 }
 
+TEST_CASE("synthetic events: with neck surgery, the neck opens and pinches by surgery, every frame checked",
+          "[morph][events]") {
+  const test::TwoBallMorph two;
+  std::vector<double> times;
+  for (int k = 0; k <= 20; ++k) times.push_back(k / 20.0);
+  MorphOptions options;
+  options.repair.neck_surgery = true;
+  for (bool forward : {true, false}) {
+    INFO((forward ? "merging" : "pinching off"));
+    const auto& source = forward ? two.source : two.target;
+    const auto& target = forward ? two.target : two.source;
+    const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin, options);
+    long necks = 0;
+    for (const FrameRecord& r : records) {
+      necks += r.stats.necks;
+      if (r.stats.necks > 0) CHECK_FALSE(r.stats.remeshed);
+    }
+    CHECK(necks == 1);
+    CHECK(records.back().components == (forward ? 1 : 2));
+  }
+}
+
 TEST_CASE("synthetic events: a component is born and one dies", "[morph][events][large]") {
   const std::vector<Ball> one{lone(0, 0, 0, 1.5)};
   const std::vector<Ball> two{lone(0, 0, 0, 1.5), lone(6, 0, 0, 1.5)};

@@ -30,6 +30,7 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <set>
 #include <unordered_map>
 
 using namespace skinmesh;
@@ -589,6 +590,76 @@ TEST_CASE("moving balls: necks that open in a step are mended by the local patch
   CHECK(f.stats.ids_kept >= 0.9);
   CHECK(f.stats.topology_certified);
   CHECK(mesh_topology(f.mesh) == after);
+}
+
+TEST_CASE("moving balls: necks that open and pinch are mended by surgery, every frame checked", "[moving]") {
+  // Two balls of radius 1.6 A approach from 0.65 A apart to 0.35 A into
+  // each other and part again, 0.1 A a frame (shrink factor 1/2: their skins
+  // join when the balls meet). At the step where they meet a neck opens,
+  // at the step where they part it pinches; each is cut and joined or
+  // capped (necks.hpp), and the frame is made without a whole remesh.
+  const double r = 1.6;
+  const auto balls_at = [&](double gap) {
+    return std::vector<Ball>{{Eigen::Vector3d(-(r + gap / 2), 0.05, 0.02), r * r},
+                             {Eigen::Vector3d(r + gap / 2, -0.03, 0.0), r * r}};
+  };
+  std::vector<double> gaps;
+  for (int k = 6; k >= -4; --k) gaps.push_back(0.1 * k + 0.05);
+  for (int k = -3; k <= 6; ++k) gaps.push_back(0.1 * k + 0.05);
+  MovingBalls engine(balls_at(gaps.front()));
+  std::set<long> ids_before(engine.frame().ids.begin(), engine.frame().ids.end());
+  long necks = 0;
+  for (size_t k = 1; k < gaps.size(); ++k) {
+    const std::vector<Ball> balls = balls_at(gaps[k]);
+    const MorphFrame& f = engine.advance_to(balls, static_cast<double>(k));
+    INFO("frame " << k << " (gap " << gaps[k] << " A): " << f.stats.events << " events, " << f.stats.necks
+                  << " necks, undone " << f.stats.necks_undone << ", remeshed " << f.stats.remeshed << " ("
+                  << f.stats.remeshed_because << ")");
+    check_frame(engine, balls, MovingOptions{}.frames.min_angle);
+    CHECK(f.stats.necks_undone == 0);
+    if (f.stats.events > 0) {
+      CHECK(f.stats.necks == f.stats.events);
+      CHECK_FALSE(f.stats.remeshed);
+    }
+    // The surgery and the edits after it change the mesh near the neck
+    // only: at the events every vertex more than 1.5 A from the plane
+    // between the balls keeps its id.
+    long new_far = 0;
+    for (size_t v = 0; v < f.mesh.vertices.size(); ++v)
+      new_far += std::abs(f.mesh.vertices[v].x()) > 1.5 && !ids_before.count(f.ids[v]);
+    if (f.stats.events > 0) CHECK(new_far == 0);
+    ids_before = std::set<long>(f.ids.begin(), f.ids.end());
+    necks += f.stats.necks;
+  }
+  CHECK(necks == 2);
+
+  // A frame the edits and the patch cannot finish after a surgery (here
+  // its first certificate is made to fail) is mended again from before it,
+  // by the patch (which may take nearly the whole of so small a frame).
+  MovingOptions options;
+  options.repair.patch.max_sample_share = 0.9;
+  MovingBalls again(balls_at(gaps.front()), options);
+  bool armed = false;
+  detail::inject_certificate_fault(again, [&](SurfaceMesh& mesh, std::vector<long>&) {
+    if (armed) mesh.triangles.pop_back();
+    armed = false;
+  });
+  long undone = 0;
+  for (size_t k = 1; k < gaps.size(); ++k) {
+    armed = true;
+    const std::vector<Ball> balls = balls_at(gaps[k]);
+    const MorphFrame& f = again.advance_to(balls, static_cast<double>(k));
+    INFO("frame " << k << ": " << f.stats.events << " events, undone " << f.stats.necks_undone << ", remeshed "
+                  << f.stats.remeshed << " (" << f.stats.remeshed_because << ")");
+    check_frame(again, balls, MovingOptions{}.frames.min_angle);
+    if (f.stats.events > 0) {
+      CHECK(f.stats.necks_undone == f.stats.events);
+      CHECK(f.stats.necks == 0);
+      CHECK_FALSE(f.stats.remeshed);
+    }
+    undone += f.stats.necks_undone;
+  }
+  CHECK(undone == 2);
 }
 
 TEST_CASE("moving balls: atoms on one side only grow out of and shrink into their anchor", "[moving]") {

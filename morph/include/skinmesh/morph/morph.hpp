@@ -116,6 +116,8 @@ struct FrameStats {
   long crowded = 0;            // vertices removed at the repair because transport crowded them
   long lost = 0;               // vertices that could not be put on the new skin (removed)
   long events = 0;             // critical topology events since the previous frame
+  long necks = 0;              // of them, necks that opened or pinched mended by surgery
+  long necks_undone = 0;       // surgeries undone: the edits and the patch could not finish the frame (moving atoms)
   bool repaired = false;       // failing triangles were repaired (locally, or by remeshing)
   long patch_triangles = 0;    // triangles replaced by the local repair
   bool remeshed = false;       // the whole frame was remeshed from its transported vertices
@@ -146,8 +148,8 @@ struct FrameStats {
   double seconds_relax = 0;      // tangential relaxation
   double seconds_judge = 0;      // every triangle judged against the frame's criteria
   double seconds_repair = 0;     // mending: edits, local repair, whole-frame remesh or rebuild
-  // Of seconds_repair: the edits (splits, flips, contractions, thinning) and
-  // the local patches (every attempt, those of a patch that failed too);
+  // Of seconds_repair: the edits (splits, flips, contractions, thinning,
+  // neck surgery) and the local patches (every attempt, those of a patch that failed too);
   // the rest is a whole-frame remesh or rebuild.
   double seconds_edits = 0;
   double seconds_patch = 0;

@@ -144,6 +144,12 @@ struct RepairPolicy {
   // puts back what the criteria need). Dimensionless. Lower lets the vertex
   // count grow frame after frame; higher leaves frames coarser, not faster.
   double crowded_below = 0.5;
+  // A neck that opens or pinches in a step is cut and joined or capped
+  // (morph/src/necks.hpp) before the edits, which refine the new triangles;
+  // false: the local patch remeshes around it. Needs the edits. Moving atoms
+  // take it (moving_balls.hpp); the blend's frames, whose patches mend many
+  // other triangles besides, took longer with it (docs/morph.md).
+  bool neck_surgery = false;
   EditPolicy edits;
   PatchPolicy patch;
 };
