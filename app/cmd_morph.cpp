@@ -232,8 +232,6 @@ FrameCheck check_blend_frame(const SurfaceMesh& mesh, const std::vector<OracleSt
   return check;
 }
 
-
-
 // A frame of the blend copied out of the morph, with what writing it needs,
 // so that it is checked and written while the next frame is made.
 struct BlendFrame {

@@ -149,8 +149,8 @@ struct FrameStats {
   double seconds_judge = 0;      // every triangle judged against the frame's criteria
   double seconds_repair = 0;     // mending: edits, local repair, whole-frame remesh or rebuild
   // Of seconds_repair: the edits (splits, flips, contractions, thinning,
-  // neck surgery) and the local patches (every attempt, those of a patch that failed too);
-  // the rest is a whole-frame remesh or rebuild.
+  // neck surgery) and the local patches (every attempt, those of a patch
+  // that failed too); the rest is a whole-frame remesh or rebuild.
   double seconds_edits = 0;
   double seconds_patch = 0;
   long patch_attempts = 0;       // restricted Delaunay refinements of a patch region with its context

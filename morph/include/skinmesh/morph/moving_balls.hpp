@@ -107,8 +107,8 @@ struct MovingOptions {
   // reach cut the context by 29% at the same remeshes. Necks are mended by
   // surgery (RepairPolicy::neck_surgery), and the edits reach eight
   // generations from a failing triangle, not three, as a neck's tube needs
-  // more splits: with both, bench_moving's frames (101) took 10% less time
-  // on 2k39 and 11% less on the DNA motion than with neither.
+  // more splits: with both, bench_moving's frames (101) took 9-11% less
+  // time on 2k39 and on the DNA motion than with neither, 2-4% on the hinge.
   RepairPolicy repair = [] {
     RepairPolicy r;
     r.neck_surgery = true;
