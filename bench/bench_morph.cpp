@@ -19,10 +19,10 @@
 // section 4), which knows neither the complex nor the live pairs.
 //
 //   bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [--only TEXT]
-//               [--neck-surgery on|off] [PAIR...]
+//               [--neck-surgery on|off] [--birth-surgery on|off] [PAIR...]
 //   (--only: run the columns whose name contains TEXT, or one of the
-//   comma-separated TEXTs: --only "b skin,c morph,c_cmd"; --neck-surgery:
-//   RepairPolicy::neck_surgery of the c column, default off as in Morph)
+//   comma-separated TEXTs: --only "b skin,c morph,c_cmd"; --neck-surgery,
+//   --birth-surgery: RepairPolicy's of the c column, default Morph's)
 //   PAIR: SOURCE:TARGET, a file optionally followed by #MODEL
 //   (default: pept:3al1, 3al1:1ubi, 1ubi:1hpv, 2k39_3models#1:#3 from data/)
 #include "cgal_reference.hpp"
@@ -90,14 +90,15 @@ std::vector<double> frame_times(int n) {
   return t;
 }
 
-Column run_morph(const Pair& p, int frames, bool local_repair, bool neck_surgery) {
+Column run_morph(const Pair& p, int frames, bool local_repair, const RepairPolicy& surgery) {
   keep_large_blocks_for_reuse();  // as `skinmesh morph` does
   const MorphOracle oracle(p.source, p.target, kShrink);
   const std::vector<double> ts = frame_times(frames);
   Column c;
   const auto start = Clock::now();
   MorphOptions options;
-  options.repair.neck_surgery = neck_surgery;
+  options.repair.neck_surgery = surgery.neck_surgery;
+  options.repair.birth_surgery = surgery.birth_surgery;
   if (!local_repair) {  // c': every failing frame remeshed whole (no edits, no patches)
     options.repair.patch.max_failing_share = 0;
     options.repair.patch.always_patch_up_to = 0;
@@ -346,7 +347,8 @@ bool names_any(const std::string& name, const std::string& list) {
 
 int main(int argc, char** argv) {
   int frames = 100, sample = 5, timeout = 3600;
-  bool cgal = true, neck_surgery = false;
+  bool cgal = true;
+  RepairPolicy surgery;  // the c column's neck_surgery and birth_surgery
   std::string only;
   std::vector<std::string> specs;
   for (int i = 1; i < argc; ++i) {
@@ -356,10 +358,11 @@ int main(int argc, char** argv) {
     else if (a == "--timeout" && i + 1 < argc) timeout = std::max(1, std::atoi(argv[++i]));
     else if (a == "--skip-cgal") cgal = false;
     else if (a == "--only" && i + 1 < argc) only = argv[++i];
-    else if (a == "--neck-surgery" && i + 1 < argc) neck_surgery = std::string(argv[++i]) == "on";
+    else if (a == "--neck-surgery" && i + 1 < argc) surgery.neck_surgery = std::string(argv[++i]) == "on";
+    else if (a == "--birth-surgery" && i + 1 < argc) surgery.birth_surgery = std::string(argv[++i]) == "on";
     else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "usage: bench_morph [--frames N] [--sample K] [--timeout S] [--skip-cgal] [--only TEXT] "
-                           "[--neck-surgery on|off] [PAIR...]\n");
+                           "[--neck-surgery on|off] [--birth-surgery on|off] [PAIR...]\n");
       return 2;
     } else specs.push_back(a);
   }
@@ -379,8 +382,8 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::function<Column()>>> columns;
     if (cgal) columns.emplace_back("a CGAL skin, all m*n pairs", [&] { return run_cgal(p, sample); });
     columns.emplace_back("b skinmesh rebuild, live pairs", [&] { return run_rebuilds(p, sample); });
-    columns.emplace_back("c morph", [&] { return run_morph(p, frames, true, neck_surgery); });
-    columns.emplace_back("c' morph, whole-frame repairs only", [&] { return run_morph(p, frames, false, false); });
+    columns.emplace_back("c morph", [&] { return run_morph(p, frames, true, surgery); });
+    columns.emplace_back("c' morph, whole-frame repairs only", [&] { return run_morph(p, frames, false, RepairPolicy{}); });
     columns.emplace_back("c_cmd skinmesh morph --pairs all", [&] { return run_command(p, frames); });
     columns.emplace_back("d transport pass (floor)", [&] { return run_transport_floor(p, frames); });
     for (const auto& [name, task] : columns) {

@@ -25,6 +25,7 @@
 //                [--first-size-margin X]   (c only: MovingOptions::first_size_margin, default the engine's)
 //                [--retry-around-faults on|off]   (c only: PatchPolicy::retry_around_faults)
 //                [--neck-surgery on|off]   (c only: RepairPolicy::neck_surgery)
+//                [--birth-surgery on|off]   (c only: RepairPolicy::birth_surgery)
 //                [--edit-generations N]   (c only: EditPolicy::generations)
 //                [--frame-log FILE]   (c only: each later frame's FrameStats, a JSON line per frame)
 #include "forked.hpp"
@@ -226,7 +227,7 @@ void log_frame(std::FILE* log, const std::string& motion, int k, const FrameStat
                             {"triangles", s.triangles}, {"moved", s.moved},
                             {"relocated", s.relocated}, {"settled", s.settled}, {"carried", s.carried},
                             {"bad_triangles", s.bad_triangles},
-                            {"events", s.events}, {"necks", s.necks}, {"necks_undone", s.necks_undone}, {"split", s.split}, {"flipped", s.flipped},
+                            {"events", s.events}, {"necks", s.necks}, {"births", s.births}, {"surgeries_undone", s.surgeries_undone}, {"split", s.split}, {"flipped", s.flipped},
                             {"contracted", s.contracted}, {"patch_triangles", s.patch_triangles},
                             {"inserted", s.inserted}, {"removed", s.removed}, {"remeshed", s.remeshed},
                             {"full_rebuild", s.full_rebuild}, {"because", s.remeshed_because}};
@@ -462,12 +463,13 @@ int main(int argc, char** argv) {
     else if (a == "--retry-around-faults" && i + 1 < argc)
       engine_options.repair.patch.retry_around_faults = std::string(argv[++i]) == "on";
     else if (a == "--neck-surgery" && i + 1 < argc) engine_options.repair.neck_surgery = std::string(argv[++i]) == "on";
+    else if (a == "--birth-surgery" && i + 1 < argc) engine_options.repair.birth_surgery = std::string(argv[++i]) == "on";
     else if (a == "--edit-generations" && i + 1 < argc) engine_options.repair.edits.generations = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr,
                    "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command] "
                    "[--first-size-margin X] [--retry-around-faults on|off] [--neck-surgery on|off] "
-                   "[--edit-generations N] [--frame-log FILE]\n");
+                   "[--birth-surgery on|off] [--edit-generations N] [--frame-log FILE]\n");
       return 2;
     }
   }

@@ -13,6 +13,7 @@
 #include "judge.hpp"
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
+#include "births.hpp"
 #include "necks.hpp"
 #include "surgery.hpp"
 #include "vanishing.hpp"
@@ -101,8 +102,8 @@ struct Morph::Impl {
                          const std::vector<SkinSample>& seeds = {});
   bool repair(const SkinComplex& next, const SurfaceMesh& moved, const std::vector<char>& drop,
               const std::vector<SkinSample>& seeds);
-  long mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing, std::vector<char>& drop,
-                  detail::LocalRepairOptions& local, long left);
+  long mend_by_surgery(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing, std::vector<char>& drop,
+                       detail::LocalRepairOptions& local, long left);
   long mend_by_edits(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                      std::vector<char>& drop);
   std::vector<char> move_vertices(const SkinComplex& next, SurfaceMesh& mesh, FrameStats& stats,
@@ -264,14 +265,20 @@ bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& mov
 }
 
 // The necks that open or pinch in the frame's step cut and joined or
-// capped (necks.hpp), their new triangles left failing for the edits; the
+// capped (necks.hpp), their new triangles left failing for the edits, and
+// the components and voids born meshed as spheres (births.hpp); the
 // changes made leave the patch's places and the Euler characteristic it
 // must make. Returns how many triangles fail (`left` when none was made).
-long Morph::Impl::mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
-                             std::vector<char>& drop, detail::LocalRepairOptions& local, long left) {
+long Morph::Impl::mend_by_surgery(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+                                  std::vector<char>& drop, detail::LocalRepairOptions& local, long left) {
   const auto start = Clock::now();
-  std::vector<char> done;
-  detail::RepairResult cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
+  std::vector<char> done(local.changes.size(), 0);
+  detail::RepairResult cut;
+  if (options_.repair.neck_surgery)
+    cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
+  const long births = options_.repair.birth_surgery
+                          ? detail::add_born_spheres(next, moved, failing, local.changes, options_.frames, cut, done)
+                          : 0;
   frame_.stats.seconds_edits += seconds_since(start);
   if (!cut.ok) return left;
   std::vector<char> dropped(cut.origin.size(), 0);
@@ -282,7 +289,8 @@ long Morph::Impl::mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::v
   detail::take_ids_and_counts(cut, frame_.ids, next_id_, frame_.stats);
   moved = std::move(cut.mesh);
   failing = std::move(cut.failing);
-  frame_.stats.necks += detail::take_done_changes(done, local);
+  frame_.stats.necks += detail::take_done_changes(done, local) - births;
+  frame_.stats.births += births;
   return cut.left;
 }
 
@@ -568,8 +576,9 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
   add_topology_changes(events_, sizes_, t_, t, moved.handled, moved.partner, local);
   const bool mendable = moved.lost_left == 0;
   long left = stats.bad_triangles;
-  if (mendable && !local.changes.empty() && options_.repair.neck_surgery && options_.repair.edits.enabled)
-    left = mend_necks(next, moved.mesh, moved.failing, moved.drop, local, left);
+  const bool surgery = options_.repair.neck_surgery || options_.repair.birth_surgery;
+  if (mendable && !local.changes.empty() && surgery && options_.repair.edits.enabled)
+    left = mend_by_surgery(next, moved.mesh, moved.failing, moved.drop, local, left);
   if (mendable && left > 0 && options_.repair.edits.enabled) left = mend_by_edits(next, moved.mesh, moved.failing, moved.drop);
   if (mendable && local.changes.empty() && left == 0) {
     frame_.mesh = std::move(moved.mesh);

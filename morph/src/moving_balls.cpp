@@ -7,6 +7,7 @@
 #include "judge.hpp"
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
+#include "births.hpp"
 #include "necks.hpp"
 #include "surgery.hpp"
 #include "unchanged_skin.hpp"
@@ -679,12 +680,12 @@ struct MovingBalls::Impl {
                      SurfaceMesh& moved, std::vector<char>& lost, Settled& settled, long& euler_change);
   bool merge_lost(SurfaceMesh& moved, std::vector<char>& lost, Settled& settled);
   struct Unmended;
-  bool mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing, Settled& settled,
-                  detail::LocalRepairOptions& local, Unmended& before);
+  bool mend_by_surgery(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing, Settled& settled,
+                       detail::LocalRepairOptions& local, Unmended& before);
   std::string edit_and_patch(const SkinComplex& next, const SkinTopology& topology, SurfaceMesh& moved,
                              std::vector<char>& lost, std::vector<char>& failing, Settled& settled,
                              detail::LocalRepairOptions& local);
-  // What mend_locally had before a neck surgery, to mend the frame again without it.
+  // What mend_locally had before a surgery, to mend the frame again without it.
   struct Unmended {
     SurfaceMesh mesh;
     std::vector<char> failing;
@@ -1139,19 +1140,21 @@ std::string MovingBalls::Impl::mend_locally(const SkinComplex& next, const SkinT
     return std::to_string(lost_count) + " vertices could not be put on the new skin nor merged into a neighbour";
   std::vector<char> failing = judge_and_relax(next, moved, settled);
   build_ahead(next, topology, critical);
-  if (local.changes.empty() || !options_.repair.neck_surgery || !options_.repair.edits.enabled)
+  const RepairPolicy& policy = options_.repair;
+  if (local.changes.empty() || !(policy.neck_surgery || policy.birth_surgery) || !policy.edits.enabled)
     return edit_and_patch(next, topology, moved, lost, failing, settled, local);
-  // Necks mended by surgery first; when the edits and the patch cannot
-  // finish the frame after it, the frame is mended again from before it,
-  // the patch remeshing around every change, before it is remeshed whole.
+  // Necks and births mended by surgery first; when the edits and the patch
+  // cannot finish the frame after it, the frame is mended again from before
+  // it, the patch remeshing around every change, before it is remeshed whole.
   Unmended before;
-  const long necks_before = s.necks;  // of the frame's earlier steps
-  if (!mend_necks(next, moved, failing, settled, local, before))
+  const long necks_before = s.necks, births_before = s.births;  // of the frame's earlier steps
+  if (!mend_by_surgery(next, moved, failing, settled, local, before))
     return edit_and_patch(next, topology, moved, lost, failing, settled, local);
   const std::string because = edit_and_patch(next, topology, moved, lost, failing, settled, local);
   if (because.empty()) return because;
-  s.necks_undone += s.necks - necks_before;
+  s.surgeries_undone += s.necks - necks_before + s.births - births_before;
   s.necks = necks_before;
+  s.births = births_before;
   moved = std::move(before.mesh);
   failing = std::move(before.failing);
   frame_.ids = std::move(before.ids);
@@ -1233,15 +1236,21 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
 }
 
 // The necks that opened or pinched in the step cut and joined or capped
-// (necks.hpp), their new triangles left failing for the edits; the changes
+// (necks.hpp), their new triangles left failing for the edits, and the
+// components and voids born meshed as spheres (births.hpp); the changes
 // made leave the patch's places and the Euler characteristic it must make.
 // False, nothing changed, when none was made; else `before` holds the frame
 // as it was.
-bool MovingBalls::Impl::mend_necks(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
-                                   Settled& settled, detail::LocalRepairOptions& local, Unmended& before) {
+bool MovingBalls::Impl::mend_by_surgery(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
+                                        Settled& settled, detail::LocalRepairOptions& local, Unmended& before) {
   const auto start = Clock::now();
-  std::vector<char> done;
-  detail::RepairResult cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
+  std::vector<char> done(local.changes.size(), 0);
+  detail::RepairResult cut;
+  if (options_.repair.neck_surgery)
+    cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
+  const long births = options_.repair.birth_surgery
+                          ? detail::add_born_spheres(next, moved, failing, local.changes, options_.frames, cut, done)
+                          : 0;
   const double seconds = seconds_since(start);
   frame_.stats.seconds_edits += seconds;
   frame_.stats.seconds_repair += seconds;
@@ -1255,7 +1264,8 @@ bool MovingBalls::Impl::mend_necks(const SkinComplex& next, SurfaceMesh& moved, 
   detail::take_ids_and_counts(cut, frame_.ids, next_id_, frame_.stats);
   moved = std::move(cut.mesh);
   failing = std::move(cut.failing);
-  frame_.stats.necks += detail::take_done_changes(done, local);
+  frame_.stats.necks += detail::take_done_changes(done, local) - births;
+  frame_.stats.births += births;
   return true;
 }
 

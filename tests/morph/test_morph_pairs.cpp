@@ -543,17 +543,27 @@ TEST_CASE("synthetic events: a component born far from the rest is meshed locall
   // A large ball, and a small one that appears 12 A away near the end: the
   // pair's ball has negative weight until t = 0.965. The large sphere moves
   // exactly (one cell), so the step holding the birth has nothing else to
-  // repair; the patch is seeded on the new sphere and must add a component
-  // (Euler characteristic up by 2). Every frame checked against CGAL's
-  // certified skin mesh of B(t).
+  // repair. The new sphere is meshed by surgery (births.hpp) or, with that
+  // off, the patch is seeded on it; either must add a component (Euler
+  // characteristic up by 2). Every frame checked against CGAL's certified
+  // skin mesh of B(t).
   const std::vector<Ball> source{lone(0, 0, 0, 3.0)};
   const std::vector<Ball> target{lone(0, 0, 0, 3.0), lone(12, 0, 0, 1.5)};
   const std::vector<double> times{0.94, 0.95, 0.96, 0.97, 0.98, 0.99};
-  const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin);
-  CHECK(records.front().components == 1);
-  CHECK(records.back().components == 2);
-  CHECK(events_repaired_in_place(records) == 1);
-  check_events_cover_changes(prepare_morph(source, target, 0.0), records);
+  for (const bool surgery : {true, false}) {
+    INFO((surgery ? "by surgery" : "by the patch"));
+    MorphOptions options;
+    options.repair.birth_surgery = surgery;
+    const std::vector<FrameRecord> records = check_frames(source, target, times, Reference::cgal_skin, options);
+    CHECK(records.front().components == 1);
+    CHECK(records.back().components == 2);
+    CHECK(events_repaired_in_place(records) == 1);
+    long births = 0, patched = 0;
+    for (const FrameRecord& r : records) births += r.stats.births, patched += r.stats.patch_triangles;
+    CHECK(births == (surgery ? 1 : 0));
+    if (surgery) CHECK(patched == 0);
+    check_events_cover_changes(prepare_morph(source, target, 0.0), records);
+  }
 }
 
 TEST_CASE("synthetic events: a component that vanishes far from the rest is dropped locally", "[morph][events]") {

@@ -4,15 +4,19 @@
 // unless it has shrunk or its refusal has aged; and the local repair, which
 // leaves a patch that is nearly the whole frame to the whole-frame remesh
 // and, after an attempt with faults, meshes again only the pieces that had
-// them and grows over the context near a new point whose star does not close.
+// them and grows over the context near a new point whose star does not close;
+// the sphere a birth adds (births.hpp).
 #include <catch2/catch.hpp>
 
 #include "test_support.hpp"
 
+#include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/skin_topology.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/moving_balls.hpp"
 #include "skinmesh/quality/guarantees.hpp"
 #include "skinmesh/quality/mesh_quality.hpp"
+#include "births.hpp"
 #include "judge.hpp"
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
@@ -22,7 +26,10 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <numeric>
+#include <optional>
 #include <set>
 
 using namespace skinmesh;
@@ -581,5 +588,101 @@ TEST_CASE("lost vertices: each merged into a neighbour, the mesh a closed orient
     CHECK_FALSE(detail::merge_lost_vertices(tetrahedron, one_lost, kept_from, touched));
     CHECK(tetrahedron.triangles == given.triangles);
     CHECK(one_lost == std::vector<char>{1, 0, 0, 0});
+  }
+}
+
+namespace {
+
+// Four balls of weight 6.1 A^2 at the corners of a tetrahedron about the
+// origin, at distance about l from it (off regular by a few hundredths of
+// an Angstrom). Their orthogonal sphere's R2 is about l^2 - 6.1: past
+// l = 2.47 A they hold a void about the origin, in the tetrahedron's
+// mixed cell while its radius sqrt(R2 / 2) stays under the cell's inradius
+// l / 6 (shrink factor 1/2).
+std::vector<Ball> tetrahedron(double l) {
+  const std::array<Eigen::Vector3d, 4> corners{Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1),
+                                               Eigen::Vector3d(-1, 1, -1), Eigen::Vector3d(-1, -1, 1)};
+  std::vector<Ball> balls;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d off = 0.01 * Eigen::Vector3d(std::sin(1.3 * k), std::cos(2.1 * k), std::sin(0.7 * k + 1));
+    balls.push_back({l * corners[static_cast<size_t>(k)].normalized() + off, 6.1});
+  }
+  return balls;
+}
+
+detail::TopologyChange birth_in(const SkinComplex& complex, int cell) {
+  detail::TopologyChange change;
+  change.birth = true;
+  change.cell = cell;
+  change.dim = complex.cell(cell).dim;
+  change.point = complex.cell(cell).center;
+  change.euler_change = 2;
+  return change;
+}
+
+// A born sphere against references that do not use it: every vertex on the
+// skin by the QP oracle, a closed oriented manifold of one component with
+// the Euler characteristic of a sphere, every triangle passing the judge,
+// facing as the skin's gradient, and the enclosed volume's sign.
+void check_born_sphere(const SkinComplex& complex, const SurfaceMesh& m, const MeshingOptions& criteria, bool is_void) {
+  const SkinOracle oracle(complex.balls(), complex.shrink());
+  double worst = 0;
+  for (const Eigen::Vector3d& x : m.vertices) worst = std::max(worst, oracle.evaluate(x).distance());
+  CHECK(worst < 1e-12);
+  const MeshQuality q = grade_mesh(m);
+  CHECK(q.closed);
+  CHECK(q.manifold);
+  CHECK(q.oriented);
+  CHECK(q.components == 1);
+  CHECK(q.euler == 2);
+  CHECK(q.min_angle >= criteria.min_angle);
+  const SurfaceComponents parts = surface_components(m);
+  REQUIRE(parts.enclosed_volume.size() == 1);
+  CHECK((parts.enclosed_volume[0] < 0) == is_void);
+  for (const auto& t : m.triangles) {
+    const std::array<Eigen::Vector3d, 3> corners{m.vertices[static_cast<size_t>(t[0])], m.vertices[static_cast<size_t>(t[1])],
+                                                 m.vertices[static_cast<size_t>(t[2])]};
+    CHECK(detail::triangle_passes(complex, corners, m.cells[static_cast<size_t>(t[0])], criteria));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("births: a component's and a void's sphere meshed on the skin, every triangle passing", "[morph]") {
+  const MeshingOptions criteria = MovingOptions{}.frames;
+  SECTION("a component: a lone ball's sphere, facing out") {
+    const SkinComplex lone = build_skin_complex({{Eigen::Vector3d(1, 2, 3), 1.7 * 1.7}});
+    const std::optional<SurfaceMesh> m = detail::born_sphere(lone, birth_in(lone, 0), criteria);
+    REQUIRE(m);
+    check_born_sphere(lone, *m, criteria, false);
+  }
+  SECTION("a void: the sphere in the tetrahedron of four balls, facing in") {
+    const SkinComplex four = build_skin_complex(tetrahedron(2.5));
+    REQUIRE(skin_topology(four.balls()).voids == 1);  // premise: one void
+    long made = 0;
+    for (int c = 0; c < static_cast<int>(four.cells().size()); ++c) {
+      if (four.cell(c).dim != 3) continue;
+      const std::optional<SurfaceMesh> m = detail::born_sphere(four, birth_in(four, c), criteria);
+      REQUIRE(m);
+      check_born_sphere(four, *m, criteria, true);
+      ++made;
+    }
+    CHECK(made == 1);
+    // Past the cell's inradius the void's skin is no longer one sphere.
+    const SkinComplex wide = build_skin_complex(tetrahedron(2.6));
+    for (int c = 0; c < static_cast<int>(wide.cells().size()); ++c)
+      if (wide.cell(c).dim == 3) CHECK_FALSE(detail::born_sphere(wide, birth_in(wide, c), criteria));
+  }
+  SECTION("a sphere the cell cuts: the skin there is not the sphere") {
+    // Two balls overlapping: each vertex cell holds only part of its ball's sphere.
+    const SkinComplex two = build_skin_complex({{Eigen::Vector3d(0, 0, 0), 2.25}, {Eigen::Vector3d(2, 0, 0), 2.25}});
+    for (int c = 0; c < static_cast<int>(two.cells().size()); ++c)
+      if (two.cell(c).dim == 0) CHECK_FALSE(detail::born_sphere(two, birth_in(two, c), criteria));
+  }
+  SECTION("not a birth, or not a vertex or tetrahedron") {
+    const SkinComplex lone = build_skin_complex({{Eigen::Vector3d(1, 2, 3), 1.7 * 1.7}});
+    detail::TopologyChange change = birth_in(lone, 0);
+    change.birth = false;
+    CHECK_FALSE(detail::born_sphere(lone, change, criteria));
   }
 }

@@ -117,7 +117,8 @@ struct FrameStats {
   long lost = 0;               // vertices that could not be put on the new skin (removed)
   long events = 0;             // critical topology events since the previous frame
   long necks = 0;              // of them, necks that opened or pinched mended by surgery
-  long necks_undone = 0;       // surgeries undone: the edits and the patch could not finish the frame (moving atoms)
+  long births = 0;             // of them, components and voids born meshed as spheres by surgery
+  long surgeries_undone = 0;   // necks and births undone: the edits and the patch could not finish the frame (moving atoms)
   bool repaired = false;       // failing triangles were repaired (locally, or by remeshing)
   long patch_triangles = 0;    // triangles replaced by the local repair
   bool remeshed = false;       // the whole frame was remeshed from its transported vertices

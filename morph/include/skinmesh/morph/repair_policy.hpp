@@ -150,6 +150,11 @@ struct RepairPolicy {
   // take it (moving_balls.hpp); the blend's frames, whose patches mend many
   // other triangles besides, took longer with it (docs/morph.md).
   bool neck_surgery = false;
+  // A component or a void born in a step (a critical event of dimension 0
+  // or 3) is meshed as a sphere of its own (morph/src/births.hpp), every
+  // triangle judged; false: the local patch remeshes around it. Needs the
+  // edits.
+  bool birth_surgery = true;
   EditPolicy edits;
   PatchPolicy patch;
 };
