@@ -81,6 +81,13 @@ std::optional<SurfaceMesh> placed(const SkinComplex& complex, int cell, const Ei
   return m;
 }
 
+// Whether a vertex of `mesh` lies in `cell` already: one that transport
+// relocated onto the new skin there. The sphere is then not added (it
+// would be meshed twice); the patch mends the birth with that vertex.
+bool already_on(const SurfaceMesh& mesh, int cell) {
+  return std::find(mesh.cells.begin(), mesh.cells.end(), cell) != mesh.cells.end();
+}
+
 }  // namespace
 
 std::optional<SurfaceMesh> born_sphere(const SkinComplex& complex, const TopologyChange& change,
@@ -110,7 +117,7 @@ long add_born_spheres(const SkinComplex& complex, const SurfaceMesh& mesh, const
   done.resize(changes.size(), 0);
   long added = 0;
   for (size_t k = 0; k < changes.size(); ++k) {
-    if (done[k]) continue;
+    if (done[k] || already_on(mesh, changes[k].cell)) continue;
     const std::optional<SurfaceMesh> sphere = born_sphere(complex, changes[k], criteria);
     if (!sphere) continue;
     if (!r.ok) {  // the frame as it was, every vertex its own origin
@@ -121,13 +128,15 @@ long add_born_spheres(const SkinComplex& complex, const SurfaceMesh& mesh, const
       for (size_t v = 0; v < r.origin.size(); ++v) r.origin[v] = static_cast<long>(v);
       r.left = std::count(failing.begin(), failing.end(), 1);
     }
-    const int base = static_cast<int>(r.mesh.vertices.size());
-    r.mesh.vertices.insert(r.mesh.vertices.end(), sphere->vertices.begin(), sphere->vertices.end());
-    if (!r.mesh.cells.empty()) r.mesh.cells.insert(r.mesh.cells.end(), sphere->cells.begin(), sphere->cells.end());
-    if (!r.mesh.normals.empty())
+    // Cells and normals follow the vertices where the mesh keeps them.
+    const size_t base = r.mesh.vertices.size();
+    if (r.mesh.cells.size() == base) r.mesh.cells.insert(r.mesh.cells.end(), sphere->cells.begin(), sphere->cells.end());
+    if (r.mesh.normals.size() == base)
       r.mesh.normals.insert(r.mesh.normals.end(), sphere->normals.begin(), sphere->normals.end());
+    r.mesh.vertices.insert(r.mesh.vertices.end(), sphere->vertices.begin(), sphere->vertices.end());
     r.origin.resize(r.mesh.vertices.size(), -1);
-    for (const auto& t : sphere->triangles) r.mesh.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+    const int first = static_cast<int>(base);
+    for (const auto& t : sphere->triangles) r.mesh.triangles.push_back({first + t[0], first + t[1], first + t[2]});
     r.failing.resize(r.mesh.triangles.size(), 0);
     done[k] = 1;
     ++added;

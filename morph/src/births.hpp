@@ -31,8 +31,9 @@ namespace skinmesh::detail {
 std::optional<SurfaceMesh> born_sphere(const SkinComplex& complex, const TopologyChange& change,
                                        const MeshingOptions& criteria);
 
-// The births among `changes` that `done` does not mark and born_sphere
-// meshes, added to `r` as components of their own and marked in `done`
+// The births among `changes` that `done` does not mark, in whose cell no
+// vertex of `mesh` lies, and that born_sphere meshes, added to `r` as
+// components of their own and marked in `done`
 // (one entry per change). `r` is the frame after a surgery before this one
 // (neck_surgery's result, when ok) or, when not ok, nothing yet: it then
 // becomes `mesh` with `failing` (origin the identity) once a sphere is

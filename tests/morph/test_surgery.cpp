@@ -679,6 +679,25 @@ TEST_CASE("births: a component's and a void's sphere meshed on the skin, every t
     for (int c = 0; c < static_cast<int>(two.cells().size()); ++c)
       if (two.cell(c).dim == 0) CHECK_FALSE(detail::born_sphere(two, birth_in(two, c), criteria));
   }
+  SECTION("added to a frame as a component of its own, but not where a vertex lies on it already") {
+    const SkinComplex lone = build_skin_complex({{Eigen::Vector3d(1, 2, 3), 1.7 * 1.7}});
+    const std::vector<detail::TopologyChange> changes{birth_in(lone, 0)};
+    SurfaceMesh empty;
+    detail::RepairResult r;
+    std::vector<char> done;
+    CHECK(detail::add_born_spheres(lone, empty, {}, changes, criteria, r, done) == 1);
+    REQUIRE(r.ok);
+    CHECK(done == std::vector<char>{1});
+    CHECK(r.mesh.cells.size() == r.mesh.vertices.size());
+    CHECK(r.failing == std::vector<char>(r.mesh.triangles.size(), 0));
+    CHECK(std::count(r.origin.begin(), r.origin.end(), -1) == static_cast<long>(r.mesh.vertices.size()));
+    // A second time over the mesh just made: its vertices lie in the cell.
+    detail::RepairResult again;
+    std::vector<char> done_again;
+    CHECK(detail::add_born_spheres(lone, r.mesh, r.failing, changes, criteria, again, done_again) == 0);
+    CHECK_FALSE(again.ok);
+    CHECK(done_again == std::vector<char>{0});
+  }
   SECTION("not a birth, or not a vertex or tetrahedron") {
     const SkinComplex lone = build_skin_complex({{Eigen::Vector3d(1, 2, 3), 1.7 * 1.7}});
     detail::TopologyChange change = birth_in(lone, 0);
