@@ -1,6 +1,7 @@
 #include "births.hpp"
 
 #include "judge.hpp"
+#include "necks.hpp"
 
 #include <algorithm>
 #include <array>
@@ -142,6 +143,16 @@ long add_born_spheres(const SkinComplex& complex, const SurfaceMesh& mesh, const
     ++added;
   }
   return added;
+}
+
+EventSurgery surgery_at_events(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                               const MeshingOptions& criteria, const RepairPolicy& policy, LocalRepairOptions& local) {
+  EventSurgery out;
+  std::vector<char> done(local.changes.size(), 0);
+  if (policy.neck_surgery) out.result = neck_surgery(complex, mesh, failing, local.changes, criteria, done);
+  if (policy.birth_surgery) out.births = add_born_spheres(complex, mesh, failing, local.changes, criteria, out.result, done);
+  out.necks = take_done_changes(done, local) - out.births;
+  return out;
 }
 
 }  // namespace skinmesh::detail

@@ -17,6 +17,7 @@
 #include "skinmesh/core/skin_complex.hpp"
 #include "skinmesh/core/surface_mesh.hpp"
 #include "skinmesh/mesher/skin_mesher.hpp"
+#include "skinmesh/morph/repair_policy.hpp"
 
 #include <optional>
 #include <vector>
@@ -42,5 +43,17 @@ std::optional<SurfaceMesh> born_sphere(const SkinComplex& complex, const Topolog
 long add_born_spheres(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
                       const std::vector<TopologyChange>& changes, const MeshingOptions& criteria, RepairResult& r,
                       std::vector<char>& done);
+
+// Surgery at a step's topology events, as `policy` allows (neck_surgery,
+// birth_surgery): necks cut and joined or capped (necks.hpp), then births
+// meshed as spheres. `result` as neck_surgery's (ok when one was made);
+// the changes made are taken out of `local` (take_done_changes), and
+// `necks` and `births` count them.
+struct EventSurgery {
+  RepairResult result;
+  long necks = 0, births = 0;
+};
+EventSurgery surgery_at_events(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                               const MeshingOptions& criteria, const RepairPolicy& policy, LocalRepairOptions& local);
 
 }  // namespace skinmesh::detail

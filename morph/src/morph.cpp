@@ -14,7 +14,6 @@
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
 #include "births.hpp"
-#include "necks.hpp"
 #include "surgery.hpp"
 #include "vanishing.hpp"
 
@@ -272,14 +271,10 @@ bool Morph::Impl::repair_locally(const SkinComplex& next, const SurfaceMesh& mov
 long Morph::Impl::mend_by_surgery(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                                   std::vector<char>& drop, detail::LocalRepairOptions& local, long left) {
   const auto start = Clock::now();
-  std::vector<char> done(local.changes.size(), 0);
-  detail::RepairResult cut;
-  if (options_.repair.neck_surgery)
-    cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
-  const long births = options_.repair.birth_surgery
-                          ? detail::add_born_spheres(next, moved, failing, local.changes, options_.frames, cut, done)
-                          : 0;
+  detail::EventSurgery surgery =
+      detail::surgery_at_events(next, moved, failing, options_.frames, options_.repair, local);
   frame_.stats.seconds_edits += seconds_since(start);
+  detail::RepairResult& cut = surgery.result;
   if (!cut.ok) return left;
   std::vector<char> dropped(cut.origin.size(), 0);
   for (size_t v = 0; v < dropped.size(); ++v)
@@ -289,8 +284,8 @@ long Morph::Impl::mend_by_surgery(const SkinComplex& next, SurfaceMesh& moved, s
   detail::take_ids_and_counts(cut, frame_.ids, next_id_, frame_.stats);
   moved = std::move(cut.mesh);
   failing = std::move(cut.failing);
-  frame_.stats.necks += detail::take_done_changes(done, local) - births;
-  frame_.stats.births += births;
+  frame_.stats.necks += surgery.necks;
+  frame_.stats.births += surgery.births;
   return cut.left;
 }
 

@@ -8,7 +8,6 @@
 #include "local_repair.hpp"
 #include "mesh_part.hpp"
 #include "births.hpp"
-#include "necks.hpp"
 #include "surgery.hpp"
 #include "unchanged_skin.hpp"
 #include "vanishing.hpp"
@@ -1244,13 +1243,10 @@ bool MovingBalls::Impl::drop_vanished(const std::vector<detail::VanishingSphere>
 bool MovingBalls::Impl::mend_by_surgery(const SkinComplex& next, SurfaceMesh& moved, std::vector<char>& failing,
                                         Settled& settled, detail::LocalRepairOptions& local, Unmended& before) {
   const auto start = Clock::now();
-  std::vector<char> done(local.changes.size(), 0);
-  detail::RepairResult cut;
-  if (options_.repair.neck_surgery)
-    cut = detail::neck_surgery(next, moved, failing, local.changes, options_.frames, done);
-  const long births = options_.repair.birth_surgery
-                          ? detail::add_born_spheres(next, moved, failing, local.changes, options_.frames, cut, done)
-                          : 0;
+  const detail::LocalRepairOptions unmended = local;
+  detail::EventSurgery surgery =
+      detail::surgery_at_events(next, moved, failing, options_.frames, options_.repair, local);
+  detail::RepairResult& cut = surgery.result;
   const double seconds = seconds_since(start);
   frame_.stats.seconds_edits += seconds;
   frame_.stats.seconds_repair += seconds;
@@ -1259,13 +1255,13 @@ bool MovingBalls::Impl::mend_by_surgery(const SkinComplex& next, SurfaceMesh& mo
   if (!settled.thinning.empty())
     for (size_t v = 0; v < thinning.size(); ++v)
       if (cut.origin[v] >= 0) thinning[v] = settled.thinning[static_cast<size_t>(cut.origin[v])];
-  before = {std::move(moved), std::move(failing), frame_.ids, next_id_, std::move(settled.thinning), local};
+  before = {std::move(moved), std::move(failing), frame_.ids, next_id_, std::move(settled.thinning), unmended};
   settled.thinning = std::move(thinning);
   detail::take_ids_and_counts(cut, frame_.ids, next_id_, frame_.stats);
   moved = std::move(cut.mesh);
   failing = std::move(cut.failing);
-  frame_.stats.necks += detail::take_done_changes(done, local) - births;
-  frame_.stats.births += births;
+  frame_.stats.necks += surgery.necks;
+  frame_.stats.births += surgery.births;
   return true;
 }
 

@@ -5,6 +5,7 @@
 // motion; the certificate refusing a wrong mesh.
 #include "test_support.hpp"
 #include "same_frames.hpp"
+#include "four_balls.hpp"
 
 #include "judge.hpp"
 #include "mesh_part.hpp"
@@ -664,7 +665,7 @@ TEST_CASE("moving balls: necks that open and pinch are mended by surgery, every 
 }
 
 TEST_CASE("moving balls: a void born is meshed as a sphere by surgery, every frame checked", "[moving]") {
-  // Four balls of weight 6.1 A^2 at the corners of a tetrahedron move out
+  // Four balls at the corners of a tetrahedron (four_balls.hpp) move out
   // from 2.425 A to 2.515 A from its centre and back, 0.01 A a frame: the
   // orthogonal sphere's R2 (about l^2 - 6.1) turns positive between 2.465
   // and 2.475 A, where a void is born in the tetrahedron's cell (shrink
@@ -672,16 +673,7 @@ TEST_CASE("moving balls: a void born is meshed as a sphere by surgery, every fra
   // The birth is meshed as a sphere of its own (births.hpp): no patch, no
   // remesh. With birth surgery off the patch meshes it, as a check that the
   // frames are the same skin either way.
-  const auto balls_at = [](double l) {
-    const std::array<Eigen::Vector3d, 4> corners{Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1),
-                                                 Eigen::Vector3d(-1, 1, -1), Eigen::Vector3d(-1, -1, 1)};
-    std::vector<Ball> balls;
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d off = 0.01 * Eigen::Vector3d(std::sin(1.3 * k), std::cos(2.1 * k), std::sin(0.7 * k + 1));
-      balls.push_back({l * corners[static_cast<size_t>(k)].normalized() + off, 6.1});
-    }
-    return balls;
-  };
+  const auto balls_at = [](double l) { return test::tetrahedron_of_balls(l); };
   std::vector<double> distances;
   for (int k = 0; k <= 9; ++k) distances.push_back(2.425 + 0.01 * k);
   for (int k = 8; k >= 0; --k) distances.push_back(2.425 + 0.01 * k);

@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 
 #include "test_support.hpp"
+#include "four_balls.hpp"
 
 #include "skinmesh/core/skin_oracle.hpp"
 #include "skinmesh/core/skin_topology.hpp"
@@ -593,23 +594,6 @@ TEST_CASE("lost vertices: each merged into a neighbour, the mesh a closed orient
 
 namespace {
 
-// Four balls of weight 6.1 A^2 at the corners of a tetrahedron about the
-// origin, at distance about l from it (off regular by a few hundredths of
-// an Angstrom). Their orthogonal sphere's R2 is about l^2 - 6.1: past
-// l = 2.47 A they hold a void about the origin, in the tetrahedron's
-// mixed cell while its radius sqrt(R2 / 2) stays under the cell's inradius
-// l / 6 (shrink factor 1/2).
-std::vector<Ball> tetrahedron(double l) {
-  const std::array<Eigen::Vector3d, 4> corners{Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1),
-                                               Eigen::Vector3d(-1, 1, -1), Eigen::Vector3d(-1, -1, 1)};
-  std::vector<Ball> balls;
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d off = 0.01 * Eigen::Vector3d(std::sin(1.3 * k), std::cos(2.1 * k), std::sin(0.7 * k + 1));
-    balls.push_back({l * corners[static_cast<size_t>(k)].normalized() + off, 6.1});
-  }
-  return balls;
-}
-
 detail::TopologyChange birth_in(const SkinComplex& complex, int cell) {
   detail::TopologyChange change;
   change.birth = true;
@@ -657,7 +641,7 @@ TEST_CASE("births: a component's and a void's sphere meshed on the skin, every t
     check_born_sphere(lone, *m, criteria, false);
   }
   SECTION("a void: the sphere in the tetrahedron of four balls, facing in") {
-    const SkinComplex four = build_skin_complex(tetrahedron(2.5));
+    const SkinComplex four = build_skin_complex(test::tetrahedron_of_balls(2.5));
     REQUIRE(skin_topology(four.balls()).voids == 1);  // premise: one void
     long made = 0;
     for (int c = 0; c < static_cast<int>(four.cells().size()); ++c) {
@@ -669,7 +653,7 @@ TEST_CASE("births: a component's and a void's sphere meshed on the skin, every t
     }
     CHECK(made == 1);
     // Past the cell's inradius the void's skin is no longer one sphere.
-    const SkinComplex wide = build_skin_complex(tetrahedron(2.6));
+    const SkinComplex wide = build_skin_complex(test::tetrahedron_of_balls(2.6));
     for (int c = 0; c < static_cast<int>(wide.cells().size()); ++c)
       if (wide.cell(c).dim == 3) CHECK_FALSE(detail::born_sphere(wide, birth_in(wide, c), criteria));
   }
