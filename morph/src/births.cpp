@@ -13,8 +13,10 @@ namespace skinmesh::detail {
 namespace {
 
 // At most this many splits of the icosahedron (20 * 4^4 = 5,120
-// triangles): the criteria scale with a sphere's radius (its target edge
-// is epsilon times the radius), so one split passes at the default sizing.
+// triangles): the size criterion scales with a sphere's radius (its target
+// edge is epsilon times the radius), the distance criterion does not, and a
+// born sphere is small: one of radius 1.2 A passes the frames' criteria
+// after two splits.
 constexpr int kMostSplits = 4;
 
 // A unit sphere's mesh: the icosahedron's 12 vertices and 20 faces,
@@ -118,7 +120,7 @@ long add_born_spheres(const SkinComplex& complex, const SurfaceMesh& mesh, const
   done.resize(changes.size(), 0);
   long added = 0;
   for (size_t k = 0; k < changes.size(); ++k) {
-    if (done[k] || already_on(mesh, changes[k].cell)) continue;
+    if (done[k] || !changes[k].birth || already_on(mesh, changes[k].cell)) continue;
     const std::optional<SurfaceMesh> sphere = born_sphere(complex, changes[k], criteria);
     if (!sphere) continue;
     if (!r.ok) {  // the frame as it was, every vertex its own origin

@@ -32,10 +32,10 @@ namespace skinmesh::detail {
 std::optional<SurfaceMesh> born_sphere(const SkinComplex& complex, const TopologyChange& change,
                                        const MeshingOptions& criteria);
 
-// The births among `changes` that `done` does not mark, in whose cell no
-// vertex of `mesh` lies, and that born_sphere meshes, added to `r` as
-// components of their own and marked in `done`
-// (one entry per change). `r` is the frame after a surgery before this one
+// The births among `changes` that `done` (one entry per change) does not
+// mark, in whose cell no vertex of `mesh` lies, and that born_sphere
+// meshes, added to `r` as components of their own and marked in `done`.
+// `r` is the frame after a surgery before this one
 // (neck_surgery's result, when ok) or, when not ok, nothing yet: it then
 // becomes `mesh` with `failing` (origin the identity) once a sphere is
 // added. New vertices have origin -1; new triangles pass (failing 0).

@@ -639,6 +639,7 @@ TEST_CASE("births: a component's and a void's sphere meshed on the skin, every t
     const std::optional<SurfaceMesh> m = detail::born_sphere(lone, birth_in(lone, 0), criteria);
     REQUIRE(m);
     check_born_sphere(lone, *m, criteria, false);
+    CHECK(m->triangles.size() == 320);  // radius 1.2 A: two splits of the icosahedron pass the frames' criteria
   }
   SECTION("a void: the sphere in the tetrahedron of four balls, facing in") {
     const SkinComplex four = build_skin_complex(test::tetrahedron_of_balls(2.5));
