@@ -19,22 +19,41 @@
 
 namespace skinmesh::detail {
 
+size_t RefusedEdges::slot_of(const Key& key) const {
+  // MurmurHash3's 64-bit finaliser of the two ids mixed: ids that follow
+  // one another land in slots far apart.
+  uint64_t h = static_cast<uint64_t>(key.first) * 0x9e3779b97f4a7c15ULL ^ static_cast<uint64_t>(key.second);
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdULL;
+  h ^= h >> 33;
+  const size_t mask = slots_.size() - 1;
+  size_t s = static_cast<size_t>(h) & mask;
+  while (slots_[s] >= 0 && entries_[static_cast<size_t>(slots_[s])].first != key) s = (s + 1) & mask;
+  return s;
+}
+
 std::vector<RefusedEdges::Entry>::const_iterator RefusedEdges::find(const Key& key) const {
-  const auto it = std::lower_bound(entries_.begin(), entries_.end(), key,
-                                   [](const Entry& e, const Key& k) { return e.first < k; });
-  return it != entries_.end() && it->first == key ? it : entries_.end();
+  if (slots_.empty()) return entries_.end();
+  const int at = slots_[slot_of(key)];
+  return at < 0 ? entries_.end() : entries_.begin() + at;
 }
 
-std::vector<RefusedEdges::Entry>::iterator RefusedEdges::find(const Key& key) {
-  const auto at = static_cast<const RefusedEdges&>(*this).find(key) - entries_.cbegin();
-  return entries_.begin() + at;
+void RefusedEdges::add(const Key& key, double length, int frames) {
+  if (2 * (entries_.size() + 1) > slots_.size()) grow();
+  const size_t s = slot_of(key);
+  if (slots_[s] >= 0) return;
+  slots_[s] = static_cast<int>(entries_.size());
+  entries_.push_back({key, {length, frames}});
 }
 
-void RefusedEdges::sort() {
-  std::stable_sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.first < b.first; });
-  entries_.erase(std::unique(entries_.begin(), entries_.end(),
-                             [](const Entry& a, const Entry& b) { return a.first == b.first; }),
-                 entries_.end());
+void RefusedEdges::reserve(size_t n) {
+  entries_.reserve(n);
+  while (slots_.size() < 2 * n) grow();
+}
+
+void RefusedEdges::grow() {
+  slots_.assign(std::max<size_t>(64, 2 * slots_.size()), -1);
+  for (size_t k = 0; k < entries_.size(); ++k) slots_[slot_of(entries_[k].first)] = static_cast<int>(k);
 }
 
 namespace {
@@ -533,9 +552,6 @@ class RefusalMemo {
   }
   RefusalMemo(const RefusalMemo&) = delete;
   RefusalMemo& operator=(const RefusalMemo&) = delete;
-  ~RefusalMemo() {
-    if (refused_) refused_->sort();
-  }
   // Refused in a frame before, neither shrunk since nor aged: skipped, and
   // remembered a frame older.
   bool still_refused(const std::optional<std::pair<long, long>>& key, double length) {

@@ -29,8 +29,9 @@ namespace skinmesh::detail {
 // Thinning contractions refused, by the vertex ids of the edge's ends
 // (smaller first): the edge's length then and the frames since. Kept by the
 // caller from frame to frame. Every short edge near a change looks itself
-// up in every frame, and each frame's memo is made anew: one array sorted
-// by the ids and searched by halving, with no allocation per edge.
+// up in every frame, and each frame's memo is made anew: one array of
+// entries with an open-addressing table of their keys, no sort and no
+// allocation per edge.
 class RefusedEdges {
  public:
   using Key = std::pair<long, long>;
@@ -38,21 +39,26 @@ class RefusedEdges {
 
   bool empty() const { return entries_.empty(); }
   size_t size() const { return entries_.size(); }
+  // Entries in the order added; their keys are not to be changed.
   std::vector<Entry>::iterator begin() { return entries_.begin(); }
   std::vector<Entry>::iterator end() { return entries_.end(); }
   std::vector<Entry>::const_iterator begin() const { return entries_.begin(); }
   std::vector<Entry>::const_iterator end() const { return entries_.end(); }
-  // The entry of `key`, or end(); the entries must be in order (sort).
+  // The entry of `key`, or end().
   std::vector<Entry>::const_iterator find(const Key& key) const;
-  std::vector<Entry>::iterator find(const Key& key);
-  // Appended in any order; sort() puts them in order, the first of a key kept.
-  void add(const Key& key, double length, int frames) { entries_.push_back({key, {length, frames}}); }
-  void sort();
-  void reserve(size_t n) { entries_.reserve(n); }
-  void swap(RefusedEdges& other) noexcept { entries_.swap(other.entries_); }
+  // A key already held keeps its first entry.
+  void add(const Key& key, double length, int frames);
+  void reserve(size_t n);
+  void swap(RefusedEdges& other) noexcept {
+    entries_.swap(other.entries_);
+    slots_.swap(other.slots_);
+  }
 
  private:
+  size_t slot_of(const Key& key) const;  // the key's slot, or the empty one it would take
+  void grow();
   std::vector<Entry> entries_;
+  std::vector<int> slots_;  // an entry's index, -1 empty; a power of two, at most half full
 };
 
 // `failing`: per triangle of `mesh`, non-zero where it fails `accept` on the
