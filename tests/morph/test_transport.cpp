@@ -252,6 +252,30 @@ TEST_CASE("tangential relaxation leaves settled vertices where they are", "[morp
   CHECK(unmoved(0.0) < settled);
 }
 
+// Relaxing some vertices (`movable`) works on those alone: every vertex
+// marked gives the whole relaxation's points, and one not marked stays
+// where it was.
+TEST_CASE("tangential relaxation of marked vertices moves those alone, as the whole relaxation moves them", "[morph]") {
+  const TransportedFrame f = transported_2k39_frame();
+  const size_t n = f.mesh.vertices.size();
+  SurfaceMesh whole = f.mesh, all_marked = f.mesh, half = f.mesh;
+  relax_tangentially(f.to, whole, RelaxationOptions{});
+  const std::vector<char> every(n, 1);
+  relax_tangentially(f.to, all_marked, RelaxationOptions{}, &every);
+  CHECK(all_marked.vertices == whole.vertices);
+  CHECK(all_marked.cells == whole.cells);
+  std::vector<char> even(n, 0);
+  for (size_t v = 0; v < n; v += 2) even[v] = 1;
+  relax_tangentially(f.to, half, RelaxationOptions{}, &even);
+  long moved = 0;
+  for (size_t v = 0; v < n; ++v) {
+    const bool unmoved = half.vertices[v] == f.mesh.vertices[v] && half.cells[v] == f.mesh.cells[v];
+    if (!even[v]) CHECK(unmoved);
+    moved += !unmoved;
+  }
+  CHECK(moved > 0);
+}
+
 TEST_CASE("tangential relaxation gives the same points with one thread as with several", "[morph]") {
   TransportedFrame f = transported_2k39_frame();
   SurfaceMesh one = f.mesh, many = f.mesh;
