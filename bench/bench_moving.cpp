@@ -27,6 +27,9 @@
 //                [--neck-surgery on|off]   (c only: RepairPolicy::neck_surgery)
 //                [--birth-surgery on|off]   (c only: RepairPolicy::birth_surgery)
 //                [--edit-generations N]   (c only: EditPolicy::generations)
+//                [--patch-share X]   (c only: PatchPolicy::max_failing_share, a share 0-1)
+//                [--sample-share X]   (c only: PatchPolicy::max_sample_share, a share 0-1)
+//                [--retry-after N]   (c only: EditPolicy::retry_after_frames)
 //                [--frame-log FILE]   (c only: each later frame's FrameStats, a JSON line per frame)
 #include "forked.hpp"
 #include "skinmesh/core/allocator.hpp"
@@ -465,11 +468,15 @@ int main(int argc, char** argv) {
     else if (a == "--neck-surgery" && i + 1 < argc) engine_options.repair.neck_surgery = std::string(argv[++i]) == "on";
     else if (a == "--birth-surgery" && i + 1 < argc) engine_options.repair.birth_surgery = std::string(argv[++i]) == "on";
     else if (a == "--edit-generations" && i + 1 < argc) engine_options.repair.edits.generations = std::atoi(argv[++i]);
+    else if (a == "--patch-share" && i + 1 < argc) engine_options.repair.patch.max_failing_share = std::atof(argv[++i]);
+    else if (a == "--retry-after" && i + 1 < argc) engine_options.repair.edits.retry_after_frames = std::atoi(argv[++i]);
+    else if (a == "--sample-share" && i + 1 < argc) engine_options.repair.patch.max_sample_share = std::atof(argv[++i]);
     else {
       std::fprintf(stderr,
                    "usage: bench_moving [--frames N] [--sample K] [--timeout S] [--only TEXT] [--skip-command] "
                    "[--first-size-margin X] [--retry-around-faults on|off] [--neck-surgery on|off] "
-                   "[--birth-surgery on|off] [--edit-generations N] [--frame-log FILE]\n");
+                   "[--birth-surgery on|off] [--edit-generations N] [--patch-share X] [--sample-share X] [--retry-after N] "
+                   "[--frame-log FILE]\n");
       return 2;
     }
   }
