@@ -47,6 +47,40 @@ std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMes
   return bad;
 }
 
+std::string FailingKinds::text() const {
+  std::string out = "not restricted " + std::to_string(not_restricted) + ", shape " + std::to_string(shape) +
+                    ", size or distance " + std::to_string(size) + ", facing inward " + std::to_string(inward);
+  if (passing > 0) out += ", passing now " + std::to_string(passing);
+  return out;
+}
+
+FailingKinds failing_kinds(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                           const MeshingOptions& criteria) {
+  if (failing.size() != mesh.triangles.size()) contract_error("failing_kinds: verdicts do not match the mesh");
+  std::vector<size_t> at;
+  for (size_t f = 0; f < failing.size(); ++f)
+    if (failing[f]) at.push_back(f);
+  std::vector<Verdict> verdicts(at.size(), Verdict::pass);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, at.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const std::array<int, 3>& t = mesh.triangles[at[k]];
+      verdicts[k] = judge_triangle(complex,
+                                   {mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
+                                    mesh.vertices[static_cast<size_t>(t[2])]},
+                                   mesh.cells[static_cast<size_t>(t[0])], criteria);
+    }
+  });
+  FailingKinds kinds;
+  for (const Verdict v : verdicts) switch (v) {
+      case Verdict::pass: ++kinds.passing; break;
+      case Verdict::size: ++kinds.size; break;
+      case Verdict::shape: ++kinds.shape; break;
+      case Verdict::inward: ++kinds.inward; break;
+      case Verdict::other: ++kinds.not_restricted; break;
+    }
+  return kinds;
+}
+
 namespace {
 
 // The triangles of `mesh` numbered in `at` judged, their verdicts into `failing`.

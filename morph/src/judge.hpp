@@ -12,6 +12,7 @@
 #include "skinmesh/morph/relaxation.hpp"
 
 #include <array>
+#include <string>
 #include <vector>
 
 namespace skinmesh::detail {
@@ -37,6 +38,19 @@ inline bool triangle_passes(const SkinComplex& complex, const std::array<Eigen::
 // Per triangle of `triangles` (corners in `mesh`), 1 where it does not pass, in parallel.
 std::vector<char> failing_triangles(const SkinComplex& complex, const SurfaceMesh& mesh,
                                     const std::vector<std::array<int, 3>>& triangles, const MeshingOptions& criteria);
+
+// The triangles of `mesh` marked in `failing` by what they fail (judged
+// again, in parallel): what a frame sent to the whole-frame remesh says
+// it could not mend.
+struct FailingKinds {
+  long not_restricted = 0;  // Verdict::other: the normal line through the circumcentre does not cross the skin exactly once within the window
+  long shape = 0, size = 0, inward = 0;
+  long passing = 0;  // marked, yet passing now
+  // "not restricted N, shape N, size or distance N, facing inward N"
+  std::string text() const;
+};
+FailingKinds failing_kinds(const SkinComplex& complex, const SurfaceMesh& mesh, const std::vector<char>& failing,
+                           const MeshingOptions& criteria);
 
 // `failing` (from failing_triangles on `mesh` before some of its vertices
 // moved) brought up to date: only the triangles with a corner marked in

@@ -593,8 +593,10 @@ void Morph::Impl::mend_frame(const SkinComplex& next, double t, Transported& mov
       frame_.stats.remeshed_because = std::to_string(moved.lost_left) +
                                       " vertices could not be put on the new skin nor merged into a neighbour";
     else if (!small)
-      frame_.stats.remeshed_because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
-                                      std::to_string(static_cast<long>(share)) + ")";
+      frame_.stats.remeshed_because =
+          std::to_string(left) + " triangles still failing after the edits (" +
+          detail::failing_kinds(next, moved.mesh, moved.failing, options_.frames).text() +
+          "), more than the local share (" + std::to_string(static_cast<long>(share)) + ")";
     if (!(mendable && small && repair_locally(next, moved.mesh, moved.failing, local))) {
       before_remesh();
       frame_.stats.crowded =

@@ -1188,7 +1188,8 @@ std::string MovingBalls::Impl::edit_and_patch(const SkinComplex& next, const Ski
   const double share = std::max(options_.repair.patch.max_failing_share * static_cast<double>(failing.size()),
                                  static_cast<double>(options_.repair.patch.always_patch_up_to));
   if (left > share) {
-    because = std::to_string(left) + " triangles still failing after the edits, more than the local share (" +
+    because = std::to_string(left) + " triangles still failing after the edits (" +
+              detail::failing_kinds(next, moved, failing, options_.frames).text() + "), more than the local share (" +
               std::to_string(static_cast<long>(share)) + ")";
   } else if (left > 0 || !local.changes.empty()) {
     const auto patch_start = Clock::now();

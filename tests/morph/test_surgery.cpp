@@ -255,6 +255,42 @@ void fewer_context_with(TurnedStrand& f, T PatchPolicy::*setting, T wider, T nar
 
 }  // namespace
 
+TEST_CASE("edits: what still fails after them is told by kind, each kind by the mesher's own criteria", "[morph]") {
+  // The strand's last 40 atoms turned by 25 degrees: the edits leave
+  // triangles failing for the patch.
+  const TurnedStrand f = turned_strand(560, 25);
+  const detail::FailingKinds kinds = detail::failing_kinds(f.to, f.edited.mesh, f.edited.failing, f.accept);
+  long not_restricted = 0, shape = 0, size = 0, inward = 0, passing = 0;
+  for (size_t k = 0; k < f.edited.failing.size(); ++k) {
+    if (!f.edited.failing[k]) continue;
+    const std::array<int, 3>& t = f.edited.mesh.triangles[k];
+    const std::array<Eigen::Vector3d, 3> corners{f.edited.mesh.vertices[static_cast<size_t>(t[0])],
+                                                 f.edited.mesh.vertices[static_cast<size_t>(t[1])],
+                                                 f.edited.mesh.vertices[static_cast<size_t>(t[2])]};
+    const auto restricted = restricted_triangle(f.to, corners, f.accept.tolerance, f.edited.mesh.cells[static_cast<size_t>(t[0])]);
+    if (!restricted) {
+      ++not_restricted;
+      continue;
+    }
+    switch (triangle_defect(f.to, *restricted, f.accept)) {
+      case TriangleDefect::none: faces_outward(f.to, *restricted) ? ++passing : ++inward; break;
+      case TriangleDefect::shape: ++shape; break;
+      case TriangleDefect::size:
+      case TriangleDefect::distance: ++size; break;
+      case TriangleDefect::topology: ++not_restricted; break;
+    }
+  }
+  INFO(kinds.text());
+  CHECK(passing == 0);  // the edits' verdicts are the frame's
+  CHECK(kinds.passing == 0);
+  CHECK(kinds.not_restricted == not_restricted);
+  CHECK(kinds.shape == shape);
+  CHECK(kinds.size == size);
+  CHECK(kinds.inward == inward);
+  CHECK(not_restricted + shape + size + inward == f.edited.left);
+  CHECK(kinds.text().rfind("not restricted " + std::to_string(not_restricted) + ", shape " + std::to_string(shape), 0) == 0);
+}
+
 TEST_CASE("local repair: after an attempt with faults only the pieces that had them are meshed again", "[morph]") {
   // The strand's last 32 atoms turned by 2 degrees, patched with and
   // without retrying in pieces.
